@@ -1,0 +1,68 @@
+#include <iostream>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "common.h"
+#include "specdeform/exceptions.h"
+#include "specdeform/spectral/basis_cache.h"
+
+namespace specdeform::cli {
+
+void add_basis_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("basis", "compute the first m manifold harmonics of a mesh");
+  struct Args {
+    std::string mesh, output;
+    bool json = false, float32 = false;
+    ManifoldHarmonicsOptions options;
+  };
+  auto args = std::make_shared<Args>();
+  cmd->add_option("MESH", args->mesh, "mesh file")->required();
+  cmd->add_option("-m,--modes", args->options.num_modes, "number of eigenpairs (default 100)")
+      ->check(kPositive);
+  cmd->add_option("-o,--output", args->output, "basis cache file to write");
+  cmd->add_flag("--float32", args->float32, "store the basis in single precision");
+  cmd->add_flag("--json", args->json, "print one JSON object on stdout");
+  add_harmonics_options(*cmd, args->options);
+  cmd->callback([args] {
+    const LoadedMesh loaded = load_mesh(args->mesh);
+    ManifoldHarmonicsOptions o = args->options;
+    o.progress = progress_bar("manifold harmonics");
+    const Stopwatch clock;
+    const ManifoldHarmonics h = compute_manifold_harmonics(loaded.mesh, o);
+    const double seconds = clock.seconds();
+    const bool converged = h.status == SolveStatus::Converged;
+    if (!args->output.empty() && converged) {
+      save_basis(args->output, h, loaded.mesh,
+                 args->float32 ? BasisPrecision::Float32 : BasisPrecision::Float64);
+    }
+    if (args->json) {
+      nlohmann::ordered_json j;
+      j["vertices"] = loaded.mesh.num_vertices();
+      j["modes"] = h.eigenvalues.size();
+      j["seconds"] = seconds;
+      j["converged"] = converged;
+      j["max_residual"] = h.max_residual;
+      j["max_orthogonality_error"] = h.max_orthogonality_error;
+      j["cluster_truncated"] = h.cluster_truncated;
+      j["bands"] = h.bands;
+      j["restarts"] = h.restarts;
+      j["solves"] = h.solves;
+      j["eigenvalues"] = std::vector<double>(h.eigenvalues.begin(), h.eigenvalues.end());
+      std::cout << j.dump() << "\n";
+    } else {
+      std::cout << h.eigenvalues.size() << " eigenpairs of " << loaded.mesh.num_vertices()
+                << " vertices in " << seconds << " s (residual " << h.max_residual
+                << ", orthonormality " << h.max_orthogonality_error << ")\n"
+                << "eigenvalues " << h.eigenvalues[0] << " ... "
+                << h.eigenvalues[h.eigenvalues.size() - 1] << "\n";
+      if (!args->output.empty() && converged) std::cout << "wrote " << args->output << "\n";
+    }
+    if (!converged) {
+      throw SolverError("manifold harmonics did not converge (residual " +
+                        std::to_string(h.max_residual) + ")");
+    }
+  });
+}
+
+}  // namespace specdeform::cli

@@ -1,0 +1,36 @@
+#include <iostream>
+#include <memory>
+
+#include "common.h"
+#include "specdeform/operators/mass_matrix.h"
+#include "specdeform/spectral/spectral_transform.h"
+
+namespace specdeform::cli {
+
+void add_smooth_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "smooth", "low-pass a mesh: reconstruct it from its first m frequencies (paper Fig. 2)");
+  struct Args {
+    std::string mesh, output, basis;
+    ManifoldHarmonicsOptions options;
+  };
+  auto args = std::make_shared<Args>();
+  cmd->add_option("MESH", args->mesh, "mesh file")->required();
+  cmd->add_option("-o,--output", args->output, "smoothed mesh to write")->required();
+  cmd->add_option("-m,--modes", args->options.num_modes, "frequencies kept (default 100)")
+      ->check(kPositive);
+  cmd->add_option("--basis", args->basis,
+                  "basis cache: read if it exists (and matches the mesh), written otherwise");
+  add_harmonics_options(*cmd, args->options);
+  cmd->callback([args] {
+    const LoadedMesh loaded = load_mesh(args->mesh);
+    const ManifoldHarmonics h = obtain_basis(loaded.mesh, args->options, args->basis);
+    const auto M = mass_matrix(loaded.mesh, h.mass);
+    const Eigen::MatrixXd smooth =
+        harmonics_inverse(h.basis, harmonics_forward(h.basis, M, loaded.mesh.V));
+    write_mesh(args->output, to_file_order(loaded.info, smooth, loaded.mesh.F));
+    std::cout << "wrote " << args->output << " (" << h.basis.cols() << " frequencies)\n";
+  });
+}
+
+}  // namespace specdeform::cli

@@ -1,0 +1,120 @@
+#include "common.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <map>
+
+#include "specdeform/exceptions.h"
+#include "specdeform/spectral/basis_cache.h"
+
+namespace specdeform::cli {
+
+namespace {
+
+CLI::Validator number_check(bool allow_zero) {
+  return CLI::Validator(
+      [allow_zero](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v)) {
+          return "'" + text + "' is not a number";
+        }
+        if (v < 0.0 || (v == 0.0 && !allow_zero)) {
+          return "'" + text + (allow_zero ? "' must be >= 0" : "' must be > 0");
+        }
+        return {};
+      },
+      allow_zero ? "NUMBER>=0" : "NUMBER>0");
+}
+
+}  // namespace
+
+const CLI::Validator kPositive = number_check(false);
+const CLI::Validator kNonNegative = number_check(true);
+
+LoadedMesh load_mesh(const std::string& path) {
+  LoadedMesh loaded = read_mesh(path);
+  const MeshReadInfo& info = loaded.info;
+  if (info.unused_vertices > 0) {
+    std::cerr << path << ": note: " << info.unused_vertices
+              << " vertices used by no face were dropped (outputs keep the file's numbering)\n";
+  }
+  if (info.collapsed_faces > 0) {
+    std::cerr << path << ": note: " << info.collapsed_faces
+              << " faces repeating a vertex were dropped\n";
+  }
+  return loaded;
+}
+
+ProgressCallback progress_bar(const std::string& label) {
+  if (!isatty(STDERR_FILENO)) return {};
+  return [label, last = -1](double fraction, std::string_view stage) mutable {
+    const int percent = static_cast<int>(fraction * 100.0);
+    if (percent == last && fraction < 1.0) return;
+    last = percent;
+    constexpr int kWidth = 30;
+    const int filled = static_cast<int>(fraction * kWidth);
+    std::fprintf(stderr, "\r%s [%s%s] %3d%% %-24.*s", label.c_str(),
+                 std::string(filled, '#').c_str(), std::string(kWidth - filled, ' ').c_str(),
+                 percent, static_cast<int>(stage.size()), stage.data());
+    if (fraction >= 1.0) std::fprintf(stderr, "\r\033[K");
+    std::fflush(stderr);
+  };
+}
+
+void add_harmonics_options(CLI::App& cmd, ManifoldHarmonicsOptions& o) {
+  static const std::map<std::string, MassType> kMass{{"lumped", MassType::Lumped},
+                                                     {"consistent", MassType::Consistent}};
+  static const std::map<std::string, EigenSolver> kSolver{{"krylov", EigenSolver::BlockKrylov},
+                                                          {"lanczos", EigenSolver::Lanczos}};
+  cmd.add_option("--mass", o.mass, "mass matrix: lumped (default) or consistent")
+      ->transform(CLI::CheckedTransformer(kMass, CLI::ignore_case));
+  cmd.add_option("--eigensolver", o.solver,
+                 "krylov (block Krylov-Schur, default) or lanczos (Spectra, the baseline)")
+      ->transform(CLI::CheckedTransformer(kSolver, CLI::ignore_case));
+  cmd.add_option("--tolerance", o.tolerance, "eigenpair residual to reach (default 1e-10)")
+      ->check(kPositive);
+  cmd.add_option("--band-size", o.band_size, "eigenpairs per shift (default: automatic)")
+      ->check(kNonNegative);
+  cmd.add_option("--block-size", o.block_size, "right-hand sides per solve (default: automatic)")
+      ->check(kNonNegative);
+}
+
+ManifoldHarmonics obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonicsOptions& options,
+                               const std::string& cache, bool* loaded) {
+  if (loaded != nullptr) *loaded = false;
+  if (!cache.empty() && std::filesystem::exists(cache)) {
+    ManifoldHarmonics h = load_basis(cache, mesh);
+    if (h.mass != options.mass) {
+      throw InputError(cache + ": the basis was computed with the other mass matrix");
+    }
+    if (h.basis.cols() < options.num_modes) {
+      throw InputError(cache + ": holds " + std::to_string(h.basis.cols()) + " frequencies, " +
+                       std::to_string(options.num_modes) + " are asked for");
+    }
+    h.basis.conservativeResize(Eigen::NoChange, options.num_modes);
+    h.eigenvalues.conservativeResize(options.num_modes);
+    if (loaded != nullptr) *loaded = true;
+    return h;
+  }
+  ManifoldHarmonicsOptions o = options;
+  o.progress = progress_bar("manifold harmonics");
+  ManifoldHarmonics h = compute_manifold_harmonics(mesh, o);
+  if (h.status != SolveStatus::Converged) {
+    throw SolverError("manifold harmonics did not converge (residual " +
+                      std::to_string(h.max_residual) + ", asked for " +
+                      std::to_string(options.tolerance) + ")");
+  }
+  if (h.cluster_truncated) {
+    std::cerr << "note: m = " << options.num_modes
+              << " ends inside a cluster of equal eigenvalues; the last basis vectors are one "
+                 "arbitrary choice within it\n";
+  }
+  if (!cache.empty()) save_basis(cache, h, mesh);
+  return h;
+}
+
+}  // namespace specdeform::cli

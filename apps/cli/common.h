@@ -1,0 +1,51 @@
+// Shared pieces of the command-line program: mesh loading with warnings, progress display,
+// timing, and the registration functions of the subcommands.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "specdeform/mesh/io.h"
+#include "specdeform/spectral/manifold_harmonics.h"
+
+namespace specdeform::cli {
+
+// Accepts a finite number > 0, with a one-line reason otherwise.
+extern const CLI::Validator kPositive;
+// Accepts a number >= 0.
+extern const CLI::Validator kNonNegative;
+
+// Reads a mesh; what the reader dropped or merged is reported on stderr.
+LoadedMesh load_mesh(const std::string& path);
+
+// A progress bar on stderr when it is a terminal; nothing otherwise.
+ProgressCallback progress_bar(const std::string& label);
+
+// Adds --mass/--solver/--tolerance/... to `cmd`, bound to `options`.
+void add_harmonics_options(CLI::App& cmd, ManifoldHarmonicsOptions& options);
+
+// Loads the basis from `cache` if given and it exists, else computes it (and saves it to
+// `cache` if given). Throws SolverError if the computation does not converge.
+ManifoldHarmonics obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonicsOptions& options,
+                               const std::string& cache, bool* loaded = nullptr);
+
+class Stopwatch {
+ public:
+  double seconds() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+void add_info_command(CLI::App& app);
+void add_basis_command(CLI::App& app);
+void add_smooth_command(CLI::App& app);
+void add_generate_command(CLI::App& app);
+void add_subdivide_command(CLI::App& app);
+void add_demo_command(CLI::App& app);
+
+}  // namespace specdeform::cli

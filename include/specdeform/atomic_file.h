@@ -1,0 +1,13 @@
+// Atomic file output: the bytes go to a temporary file beside the target, which is then renamed
+// over it, so readers never see a half-written file and a failed write leaves the old file intact.
+#pragma once
+
+#include <filesystem>
+#include <string_view>
+
+namespace specdeform {
+
+// Throws InputError (naming the path) if the file cannot be written.
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+
+}  // namespace specdeform

@@ -1,0 +1,32 @@
+// On-disk cache of a manifold-harmonics basis.
+//
+// Binary, little-endian, versioned:
+//   "SDBASIS\0" (8 bytes) | version u32 | n u32 | m u32 | mass u8 (0 lumped, 1 consistent) |
+//   scalar u8 (8 = float64, 4 = float32) | reserved u16 | mesh hash u64 |
+//   eigenvalues (m x f64) | basis (n x m, column-major, float64 or float32)
+// The mesh hash covers the vertex positions and the faces, so loading refuses, with a clear
+// message, a basis that was computed for another mesh (or another version of it). float32
+// storage halves the file; loading converts back to double. Files are written atomically.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+
+#include "specdeform/mesh/triangle_mesh.h"
+#include "specdeform/spectral/manifold_harmonics.h"
+
+namespace specdeform {
+
+enum class BasisPrecision { Float64, Float32 };
+
+// 64-bit FNV-1a of the vertex coordinates' bits and the face indices.
+uint64_t mesh_hash(const TriangleMesh& mesh);
+
+void save_basis(const std::filesystem::path& path, const ManifoldHarmonics& basis,
+                const TriangleMesh& mesh, BasisPrecision precision = BasisPrecision::Float64);
+
+// Throws InputError if the file is unreadable, not a basis file, of another version, truncated,
+// or computed for another mesh.
+ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMesh& mesh);
+
+}  // namespace specdeform

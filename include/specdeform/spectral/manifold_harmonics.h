@@ -1,0 +1,88 @@
+// Manifold harmonics: the first m eigenpairs of the Laplace-Beltrami operator,
+//     K h = lambda M h,   ascending lambda,   H^T M H = I,
+// with K the cotangent stiffness matrix (operators/cotan_laplacian.h) and M the lumped or
+// consistent mass matrix (operators/mass_matrix.h). Vallet & Levy, "Spectral geometry processing
+// with manifold harmonics" (2008); the basis of Rong, Cao & Guo, "Spectral mesh deformation"
+// (2008).
+//
+// Units: eigenvalues in 1/length^2 of the mesh (the unit sphere gives l(l+1)); the basis is
+// M-orthonormal in the mesh's units (H^T M H = I). Internally the problem is solved on the mesh
+// scaled to unit area, so tolerances and the shift do not depend on the mesh's size.
+//
+// Solvers:
+//  - BlockKrylov (default): shift-invert block Krylov-Schur with thick restarts. K - sigma M is
+//    factored once per band with CHOLMOD, each step solves for a whole block of right-hand sides,
+//    orthogonalisation is blocked (BLAS-3). For large m the spectrum is computed band by band
+//    (interior shifts, LDL^T), each band deflated against the pairs already found.
+//  - Lanczos: Spectra's SymGEigsShiftSolver (implicitly restarted Lanczos, ncv = 2m + 1) on the
+//    same CHOLMOD shift-invert operator. The plain baseline.
+// Each eigenvector's sign is fixed so that its entry of largest magnitude is positive; random
+// start vectors are seeded, so the output is reproducible. Several connected components give
+// one zero eigenvalue each. If m ends inside a cluster of (nearly) equal eigenvalues, the
+// truncated basis depends on an arbitrary rotation of that cluster: `cluster_truncated` says so.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string_view>
+
+#include <Eigen/Core>
+#include <Eigen/Sparse>
+
+#include "specdeform/mesh/triangle_mesh.h"
+#include "specdeform/operators/mass_matrix.h"
+
+namespace specdeform {
+
+enum class EigenSolver { BlockKrylov, Lanczos };
+
+// Called now and then during long computations: fraction done in [0, 1] and the stage's name.
+using ProgressCallback = std::function<void(double fraction, std::string_view stage)>;
+
+struct ManifoldHarmonicsOptions {
+  int num_modes = 100;  // m, 1 <= m < n
+  MassType mass = MassType::Lumped;
+  EigenSolver solver = EigenSolver::BlockKrylov;
+  double tolerance = 1e-10;   // residual each pair must reach, see eigen_residual
+  double shift = -0.1;        // first shift sigma on the unit-area scale; must be < 0
+  int block_size = 0;         // columns per block solve; 0: automatic
+  int band_size = 0;          // eigenpairs per band; 0: automatic
+  int max_restarts = 60;      // restarts per band (BlockKrylov) or Lanczos iterations / 10
+  uint64_t seed = 1;          // for the random start block
+  ProgressCallback progress;  // optional
+};
+
+enum class SolveStatus { Converged, NotConverged };
+
+struct ManifoldHarmonics {
+  Eigen::VectorXd eigenvalues;  // m, ascending, mesh units
+  Eigen::MatrixXd basis;        // n x m, H^T M H = I
+  MassType mass = MassType::Lumped;
+
+  SolveStatus status = SolveStatus::Converged;
+  double max_residual = 0.0;             // max over pairs, as `tolerance` defines it
+  double max_orthogonality_error = 0.0;  // max |H^T M H - I|
+  bool cluster_truncated = false;        // lambda_m is (nearly) equal to lambda_{m+1}
+  int bands = 0;                         // shifts used (= factorizations)
+  int restarts = 0;
+  long long solves = 0;  // right-hand sides solved with the factorization
+};
+
+ManifoldHarmonics compute_manifold_harmonics(const TriangleMesh& mesh,
+                                             const ManifoldHarmonicsOptions& options = {});
+
+// The same from the operators: K (stiffness) and M (mass, symmetric positive definite), n x n.
+ManifoldHarmonics compute_manifold_harmonics(const Eigen::SparseMatrix<double>& K,
+                                             const Eigen::SparseMatrix<double>& M,
+                                             const ManifoldHarmonicsOptions& options);
+
+// The residual of the computed pairs on the unit-area scale (area A = sum of M's entries):
+//     max_i  A ||K h_i - lambda_i M h_i||_{D^-1} / max(A lambda_i, 1),
+// D the row sums of M (= M when lumped). This is the measure of `tolerance`.
+double eigen_residual(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M,
+                      const Eigen::MatrixXd& H, const Eigen::VectorXd& lambda);
+
+// max |H^T M H - I|.
+double orthonormality_error(const Eigen::SparseMatrix<double>& M, const Eigen::MatrixXd& H);
+
+}  // namespace specdeform

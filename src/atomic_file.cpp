@@ -1,0 +1,52 @@
+#include "specdeform/atomic_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <string>
+
+#include "specdeform/exceptions.h"
+
+namespace specdeform {
+
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
+  std::string tmp_name = ".";
+  tmp_name += path.filename().string();
+  tmp_name += ".XXXXXX";
+  std::string tmp = (dir / tmp_name).string();
+  const int fd = mkstemp(tmp.data());
+  if (fd < 0) {
+    throw InputError(path.string() + ": cannot write: " + std::strerror(errno));
+  }
+  const auto fail = [&](const char* what) {
+    const std::string reason = std::strerror(errno);
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    throw InputError(path.string() + ": " + what + ": " + reason);
+  };
+  size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t wrote = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (wrote < 0) {
+      if (errno == EINTR) continue;
+      fail("cannot write");
+    }
+    done += static_cast<size_t>(wrote);
+  }
+  if (::fchmod(fd, 0644) != 0 || ::fsync(fd) != 0) fail("cannot write");
+  if (::close(fd) != 0) {
+    ::unlink(tmp.c_str());
+    throw InputError(path.string() + ": cannot write: " + std::strerror(errno));
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string reason = std::strerror(errno);
+    ::unlink(tmp.c_str());
+    throw InputError(path.string() + ": cannot write: " + reason);
+  }
+}
+
+}  // namespace specdeform

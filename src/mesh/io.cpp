@@ -1,0 +1,241 @@
+#include "specdeform/mesh/io.h"
+
+#include <algorithm>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "polygon_soup.h"
+#include "specdeform/atomic_file.h"
+#include "specdeform/exceptions.h"
+
+namespace specdeform {
+
+MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".obj") return MeshFormat::Obj;
+  if (ext == ".off") return MeshFormat::Off;
+  if (ext == ".ply") return MeshFormat::Ply;
+  if (ext == ".stl") return MeshFormat::Stl;
+  throw InputError(path.string() + ": unknown mesh format '" + ext +
+                   "' (expected .obj, .off, .ply or .stl)");
+}
+
+namespace detail {
+
+LoadedMesh build_mesh(PolygonSoup soup, const std::string& name) {
+  const int nv = soup.num_vertices();
+  if (nv == 0) throw InputError(name + ": no vertices");
+  for (int i = 0; i < nv; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isfinite(soup.xyz[3 * i + k])) {
+        throw InputError(name + ": vertex " + std::to_string(i) +
+                         " has a NaN or infinite coordinate");
+      }
+    }
+  }
+  LoadedMesh out;
+  MeshReadInfo& info = out.info;
+  info.file_faces = soup.num_polygons();
+  info.welded_corners = soup.welded_corners;
+  info.file_vertices = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
+      soup.xyz.data(), nv, 3);
+
+  std::vector<int> tris;
+  for (int p = 0; p < soup.num_polygons(); ++p) {
+    const int begin = soup.offsets[p];
+    const int k = soup.offsets[p + 1] - begin;
+    for (int c = 1; c + 1 < k; ++c) {  // fan triangulation
+      const int a = soup.indices[begin], b = soup.indices[begin + c],
+                d = soup.indices[begin + c + 1];
+      if (a == b || b == d || a == d) {
+        ++info.collapsed_faces;
+        continue;
+      }
+      tris.insert(tris.end(), {a, b, d});
+      info.face_to_file.push_back(p);
+    }
+  }
+  if (tris.empty()) {
+    throw InputError(name + (info.collapsed_faces > 0
+                                 ? ": every face repeats a vertex"
+                                 : ": no faces (a point cloud is not a surface)"));
+  }
+  std::vector<int> new_index(nv, -1);
+  for (const int v : tris) new_index[v] = 0;
+  for (int i = 0; i < nv; ++i) {
+    if (new_index[i] == 0) {
+      new_index[i] = static_cast<int>(info.vertex_to_file.size());
+      info.vertex_to_file.push_back(i);
+    }
+  }
+  info.unused_vertices = nv - static_cast<int>(info.vertex_to_file.size());
+  const int n = static_cast<int>(info.vertex_to_file.size());
+  out.mesh.V.resize(n, 3);
+  for (int i = 0; i < n; ++i) out.mesh.V.row(i) = info.file_vertices.row(info.vertex_to_file[i]);
+  const int nf = static_cast<int>(tris.size() / 3);
+  out.mesh.F.resize(nf, 3);
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) out.mesh.F(f, k) = new_index[tris[3 * f + k]];
+  return out;
+}
+
+}  // namespace detail
+
+LoadedMesh read_mesh_from_memory(std::string_view data, MeshFormat format, std::string_view name) {
+  const std::string n(name);
+  switch (format) {
+    case MeshFormat::Obj:
+      return detail::build_mesh(detail::parse_obj(data, n), n);
+    case MeshFormat::Off:
+      return detail::build_mesh(detail::parse_off(data, n), n);
+    case MeshFormat::Ply:
+      return detail::build_mesh(detail::parse_ply(data, n), n);
+    case MeshFormat::Stl:
+      return detail::build_mesh(detail::parse_stl(data, n), n);
+  }
+  throw InputError(n + ": unknown format");
+}
+
+LoadedMesh read_mesh(const std::filesystem::path& path) {
+  const MeshFormat format = mesh_format_from_path(path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path.string() + ": is a directory");
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw InputError(path.string() + ": cannot open file");
+  std::ostringstream bytes;
+  bytes << file.rdbuf();
+  if (file.bad()) throw InputError(path.string() + ": read error");
+  return read_mesh_from_memory(bytes.str(), format, path.string());
+}
+
+TriangleMesh to_file_order(const MeshReadInfo& info, const Vertices& V, const Faces& F) {
+  TriangleMesh out{info.file_vertices, Faces(F.rows(), 3)};
+  for (int i = 0; i < V.rows(); ++i) out.V.row(info.vertex_to_file[i]) = V.row(i);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) out.F(f, k) = info.vertex_to_file[F(f, k)];
+  return out;
+}
+
+namespace {
+
+void append_number(std::string& s, double v) {
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
+  s.append(buf, end);
+}
+
+void append_number(std::string& s, int v) {
+  char buf[16];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  s.append(buf, end);
+}
+
+template <typename T>
+void append_le(std::string& s, T v) {
+  static_assert(std::endian::native == std::endian::little, "writers assume a little-endian host");
+  char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  s.append(b, sizeof(T));
+}
+
+std::string encode_obj(const TriangleMesh& m) {
+  std::string s = "# written by specdeform\n";
+  for (int i = 0; i < m.num_vertices(); ++i) {
+    s += 'v';
+    for (int k = 0; k < 3; ++k) {
+      s += ' ';
+      append_number(s, m.V(i, k));
+    }
+    s += '\n';
+  }
+  for (int f = 0; f < m.num_faces(); ++f) {
+    s += 'f';
+    for (int k = 0; k < 3; ++k) {
+      s += ' ';
+      append_number(s, m.F(f, k) + 1);
+    }
+    s += '\n';
+  }
+  return s;
+}
+
+std::string encode_off(const TriangleMesh& m) {
+  std::string s = "OFF\n";
+  append_number(s, m.num_vertices());
+  s += ' ';
+  append_number(s, m.num_faces());
+  s += " 0\n";
+  for (int i = 0; i < m.num_vertices(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      append_number(s, m.V(i, k));
+      s += k < 2 ? ' ' : '\n';
+    }
+  }
+  for (int f = 0; f < m.num_faces(); ++f) {
+    s += '3';
+    for (int k = 0; k < 3; ++k) {
+      s += ' ';
+      append_number(s, m.F(f, k));
+    }
+    s += '\n';
+  }
+  return s;
+}
+
+std::string encode_ply(const TriangleMesh& m) {
+  std::string s = "ply\nformat binary_little_endian 1.0\ncomment written by specdeform\n";
+  s += "element vertex " + std::to_string(m.num_vertices()) + "\n";
+  s += "property double x\nproperty double y\nproperty double z\n";
+  s += "element face " + std::to_string(m.num_faces()) + "\n";
+  s += "property list uchar int vertex_indices\nend_header\n";
+  for (int i = 0; i < m.num_vertices(); ++i)
+    for (int k = 0; k < 3; ++k) append_le(s, m.V(i, k));
+  for (int f = 0; f < m.num_faces(); ++f) {
+    append_le(s, uint8_t{3});
+    for (int k = 0; k < 3; ++k) append_le(s, int32_t{m.F(f, k)});
+  }
+  return s;
+}
+
+std::string encode_stl(const TriangleMesh& m) {
+  std::string s(80, ' ');
+  s.replace(0, 22, "binary STL, specdeform");
+  append_le(s, static_cast<uint32_t>(m.num_faces()));
+  const auto N = face_normals(m);
+  for (int f = 0; f < m.num_faces(); ++f) {
+    for (int k = 0; k < 3; ++k) append_le(s, static_cast<float>(N(f, k)));
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 3; ++k) append_le(s, static_cast<float>(m.V(m.F(f, c), k)));
+    append_le(s, uint16_t{0});
+  }
+  return s;
+}
+
+}  // namespace
+
+std::string encode_mesh(const TriangleMesh& mesh, MeshFormat format) {
+  switch (format) {
+    case MeshFormat::Obj:
+      return encode_obj(mesh);
+    case MeshFormat::Off:
+      return encode_off(mesh);
+    case MeshFormat::Ply:
+      return encode_ply(mesh);
+    case MeshFormat::Stl:
+      return encode_stl(mesh);
+  }
+  return {};
+}
+
+void write_mesh(const std::filesystem::path& path, const TriangleMesh& mesh) {
+  write_file_atomically(path, encode_mesh(mesh, mesh_format_from_path(path)));
+}
+
+}  // namespace specdeform

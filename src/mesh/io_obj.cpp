@@ -1,0 +1,72 @@
+#include <string>
+
+#include "polygon_soup.h"
+#include "text_scanner.h"
+
+namespace specdeform::detail {
+
+namespace {
+
+// Joins lines ending in a backslash (OBJ line continuation) into one.
+std::string join_continued_lines(std::string_view data) {
+  std::string out;
+  out.reserve(data.size());
+  for (size_t i = 0; i < data.size(); ++i) {
+    if (data[i] == '\\') {
+      size_t j = i + 1;
+      while (j < data.size() && (data[j] == ' ' || data[j] == '\t' || data[j] == '\r')) ++j;
+      if (j == data.size() || data[j] == '\n') {
+        out += ' ';
+        i = j;
+        continue;
+      }
+    }
+    out += data[i];
+  }
+  return out;
+}
+
+}  // namespace
+
+PolygonSoup parse_obj(std::string_view raw, const std::string& name) {
+  const std::string data = join_continued_lines(raw);
+  TextScanner in(data, name);
+  PolygonSoup soup;
+  std::vector<int> corners;
+  int line_faces = 0;
+  for (std::string_view key = in.next(); !key.empty(); key = in.next()) {
+    if (key == "v") {
+      for (int k = 0; k < 3; ++k) soup.xyz.push_back(in.next_double("a vertex"));
+    } else if (key == "f") {
+      // Corners are v, v/vt, v//vn or v/vt/vn (also "v/vt/"); only v matters. Negative indices
+      // count back from the last vertex read so far.
+      corners.clear();
+      while (!in.at_line_end()) {
+        const std::string_view corner = in.next();
+        const std::string_view v = corner.substr(0, corner.find('/'));
+        long long index = 0;
+        const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), index);
+        if (ec != std::errc() || end != v.data() + v.size() || index == 0) {
+          in.fail("bad face corner '" + std::string(corner.substr(0, 32)) + "' in face " +
+                  std::to_string(line_faces));
+        }
+        const long long nv = soup.num_vertices();
+        const long long zero_based = index > 0 ? index - 1 : nv + index;
+        if (zero_based < 0 || zero_based >= nv) {
+          in.fail("face " + std::to_string(line_faces) + " references vertex " +
+                  std::to_string(index) + " but only " + std::to_string(nv) +
+                  " vertices precede it");
+        }
+        corners.push_back(static_cast<int>(zero_based));
+      }
+      for (const int c : corners) soup.add_polygon_corner(c);
+      soup.end_polygon();
+      ++line_faces;
+    }
+    in.skip_line();  // vt, vn, g, o, s, usemtl, mtllib, l, p, and the rest of a v line (colours)
+  }
+  if (soup.num_vertices() == 0 && soup.num_polygons() == 0) in.fail("empty file (no vertices)");
+  return soup;
+}
+
+}  // namespace specdeform::detail

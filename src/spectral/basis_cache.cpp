@@ -1,0 +1,123 @@
+#include "specdeform/spectral/basis_cache.h"
+
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "specdeform/atomic_file.h"
+#include "specdeform/exceptions.h"
+
+namespace specdeform {
+
+namespace {
+
+constexpr char kMagic[8] = {'S', 'D', 'B', 'A', 'S', 'I', 'S', '\0'};
+constexpr uint32_t kVersion = 1;
+constexpr size_t kHeaderSize = 8 + 4 + 4 + 4 + 1 + 1 + 2 + 8;
+
+static_assert(std::endian::native == std::endian::little, "the cache format is little-endian");
+
+template <typename T>
+void put(std::string& out, T v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+template <typename T>
+T get(const char*& p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  p += sizeof(T);
+  return v;
+}
+
+}  // namespace
+
+uint64_t mesh_hash(const TriangleMesh& mesh) {
+  uint64_t h = 1469598103934665603ULL;
+  const auto mix = [&h](const void* data, size_t bytes) {
+    const auto* b = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < bytes; ++i) h = (h ^ b[i]) * 1099511628211ULL;
+  };
+  const int n = mesh.num_vertices(), f = mesh.num_faces();
+  mix(&n, sizeof n);
+  mix(&f, sizeof f);
+  mix(mesh.V.data(), sizeof(double) * mesh.V.size());
+  mix(mesh.F.data(), sizeof(int) * mesh.F.size());
+  return h;
+}
+
+void save_basis(const std::filesystem::path& path, const ManifoldHarmonics& basis,
+                const TriangleMesh& mesh, BasisPrecision precision) {
+  const auto n = static_cast<uint32_t>(basis.basis.rows());
+  const auto m = static_cast<uint32_t>(basis.basis.cols());
+  if (n != static_cast<uint32_t>(mesh.num_vertices()) || basis.eigenvalues.size() != m) {
+    throw InputError(path.string() + ": the basis does not match the mesh it is saved with");
+  }
+  const bool single = precision == BasisPrecision::Float32;
+  std::string out;
+  out.reserve(kHeaderSize + 8 * size_t(m) + (single ? 4 : 8) * size_t(n) * m);
+  out.append(kMagic, 8);
+  put(out, kVersion);
+  put(out, n);
+  put(out, m);
+  put(out, static_cast<uint8_t>(basis.mass == MassType::Lumped ? 0 : 1));
+  put(out, static_cast<uint8_t>(single ? 4 : 8));
+  put(out, uint16_t{0});
+  put(out, mesh_hash(mesh));
+  out.append(reinterpret_cast<const char*>(basis.eigenvalues.data()), 8 * size_t(m));
+  if (single) {
+    const Eigen::MatrixXf H = basis.basis.cast<float>();
+    out.append(reinterpret_cast<const char*>(H.data()), 4 * size_t(n) * m);
+  } else {
+    out.append(reinterpret_cast<const char*>(basis.basis.data()), 8 * size_t(n) * m);
+  }
+  write_file_atomically(path, out);
+}
+
+ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMesh& mesh) {
+  const std::string name = path.string();
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw InputError(name + ": cannot open basis file");
+  char header[kHeaderSize];
+  if (!file.read(header, kHeaderSize)) throw InputError(name + ": not a basis file (too short)");
+  if (std::memcmp(header, kMagic, 8) != 0) throw InputError(name + ": not a specdeform basis file");
+  const char* p = header + 8;
+  const auto version = get<uint32_t>(p);
+  if (version != kVersion) {
+    throw InputError(name + ": basis file version " + std::to_string(version) +
+                     " is not supported (this build reads version " + std::to_string(kVersion) +
+                     ")");
+  }
+  const auto n = get<uint32_t>(p);
+  const auto m = get<uint32_t>(p);
+  const auto mass = get<uint8_t>(p);
+  const auto scalar = get<uint8_t>(p);
+  get<uint16_t>(p);
+  const auto hash = get<uint64_t>(p);
+  if (n != static_cast<uint32_t>(mesh.num_vertices()) || hash != mesh_hash(mesh)) {
+    throw InputError(name + ": the basis belongs to another mesh (" + std::to_string(n) +
+                     " vertices, different geometry or faces); recompute it");
+  }
+  if (mass > 1 || (scalar != 4 && scalar != 8) || m == 0 || m > n) {
+    throw InputError(name + ": corrupt basis header");
+  }
+  ManifoldHarmonics out;
+  out.mass = mass == 0 ? MassType::Lumped : MassType::Consistent;
+  out.eigenvalues.resize(m);
+  out.basis.resize(n, m);
+  bool ok =
+      static_cast<bool>(file.read(reinterpret_cast<char*>(out.eigenvalues.data()), 8 * size_t(m)));
+  if (ok && scalar == 8) {
+    ok = static_cast<bool>(file.read(reinterpret_cast<char*>(out.basis.data()), 8 * size_t(n) * m));
+  } else if (ok) {
+    Eigen::MatrixXf H(n, m);
+    ok = static_cast<bool>(file.read(reinterpret_cast<char*>(H.data()), 4 * size_t(n) * m));
+    out.basis = H.cast<double>();
+  }
+  if (!ok) throw InputError(name + ": truncated basis file");
+  return out;
+}
+
+}  // namespace specdeform

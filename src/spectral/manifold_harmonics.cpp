@@ -1,0 +1,561 @@
+#include "specdeform/spectral/manifold_harmonics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <numeric>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Spectra/SymGEigsShiftSolver.h>
+#include <Eigen/CholmodSupport>
+#include <Eigen/Eigenvalues>
+
+#include "specdeform/exceptions.h"
+#include "specdeform/operators/cotan_laplacian.h"
+
+namespace specdeform {
+
+namespace {
+
+using Mat = Eigen::MatrixXd;
+using Vec = Eigen::VectorXd;
+using Sparse = Eigen::SparseMatrix<double>;
+
+// Meshes this small (or bases this close to complete) are solved densely.
+constexpr int kDenseLimit = 1200;
+
+// M X, with a fast path for a diagonal (lumped) M.
+class MassOperator {
+ public:
+  explicit MassOperator(const Sparse& M) : M_(M) {
+    diagonal_ = M.nonZeros() == M.rows();
+    for (int j = 0; j < M.outerSize() && diagonal_; ++j)
+      for (Sparse::InnerIterator it(M, j); it; ++it)
+        if (it.row() != it.col()) diagonal_ = false;
+    if (diagonal_) d_ = M.diagonal();
+  }
+  template <typename Derived>
+  Mat apply(const Eigen::MatrixBase<Derived>& X) const {
+    if (diagonal_) return d_.asDiagonal() * X;
+    return M_ * X;
+  }
+  const Sparse& matrix() const { return M_; }
+
+ private:
+  const Sparse& M_;
+  bool diagonal_ = false;
+  Vec d_;
+};
+
+Mat random_block(int rows, int cols, std::mt19937_64& rng) {
+  std::normal_distribution<double> normal;
+  Mat X(rows, cols);
+  for (Eigen::Index j = 0; j < X.size(); ++j) X.data()[j] = normal(rng);
+  return X;
+}
+
+// Factorization of S = K - sigma M: supernodal LL^T when sigma is below the spectrum (S positive
+// definite), simplicial LDL^T for an interior shift. A shift that falls (nearly) on an eigenvalue
+// makes S (nearly) singular: `usable()` tells, and the caller moves the shift.
+class ShiftInvert {
+ public:
+  ShiftInvert(const Sparse& K, const Sparse& M, double sigma, std::mt19937_64& rng)
+      : sigma_(sigma), S_(K - sigma * M) {
+    ok_ = definite() ? (llt_.compute(S_), llt_.info() == Eigen::Success)
+                     : (ldlt_.compute(S_), ldlt_.info() == Eigen::Success);
+    if (ok_ && !definite()) {
+      const Mat b = random_block(static_cast<int>(S_.rows()), 1, rng);
+      const Mat x = solve(b);
+      ok_ = x.allFinite() && (b - S_ * x).norm() <= 1e-10 * b.norm();
+    }
+  }
+  bool usable() const { return ok_; }
+  // LDL^T of an indefinite matrix is computed without pivoting; one step of iterative
+  // refinement brings its solves from ~1e-10 back to round-off, which the Krylov relation needs.
+  Mat solve(const Mat& B) const {
+    if (definite()) return llt_.solve(B);
+    Mat X = ldlt_.solve(B);
+    X += ldlt_.solve(B - S_ * X);
+    return X;
+  }
+  double sigma() const { return sigma_; }
+
+ private:
+  bool definite() const { return sigma_ < 0.0; }
+  double sigma_;
+  Sparse S_;
+  bool ok_ = false;
+  Eigen::CholmodSupernodalLLT<Sparse, Eigen::Lower> llt_;
+  Eigen::CholmodSimplicialLDLT<Sparse, Eigen::Lower> ldlt_;
+};
+
+Vec m_norms(const Mat& X, const MassOperator& M) {
+  return M.apply(X).cwiseProduct(X).colwise().sum().cwiseMax(0.0).cwiseSqrt().transpose();
+}
+
+// Makes the columns of W M-orthonormal and M-orthogonal to the columns of each basis in `against`
+// (each M-orthonormal): block classical Gram-Schmidt against the bases (BLAS-3), repeated only
+// when it cancelled most of a column (Kahan-Parlett "twice is enough"), then Gram-Schmidt within
+// the block. A column that vanishes is replaced by a random one.
+using Basis = Eigen::Ref<const Mat>;
+
+void orthonormalize(Mat& W, std::initializer_list<Basis> against, const MassOperator& M,
+                    std::mt19937_64& rng) {
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    Vec before = m_norms(W, M);
+    for (int pass = 0; pass < 2; ++pass) {
+      const Mat MW = M.apply(W);
+      for (const Basis& B : against) {
+        if (B.cols() > 0) W.noalias() -= B * (B.transpose() * MW);
+      }
+      const Vec after = m_norms(W, M);
+      if ((after.array() > 0.5 * before.array()).all()) break;
+      before = after;
+    }
+    bool replaced = false;
+    for (int j = 0; j < W.cols(); ++j) {
+      const double norm0 = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
+      for (int pass = 0; pass < 2 && j > 0; ++pass) {
+        const Vec Mw = M.apply(W.col(j)).col(0);
+        W.col(j) -= W.leftCols(j) * (W.leftCols(j).transpose() * Mw);
+      }
+      const double norm = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
+      if (!(norm > 1e-8 * norm0)) {
+        W.col(j) = random_block(static_cast<int>(W.rows()), 1, rng);
+        replaced = true;
+      } else {
+        W.col(j) /= norm;
+      }
+    }
+    if (!replaced) return;
+  }
+  throw SolverError("cannot extend the Krylov basis (the problem is smaller than the basis)");
+}
+
+struct BandResult {
+  Vec lambda;  // unit-area scale, ascending
+  Mat H;       // M-orthonormal, orthogonal to the kept pairs
+  bool converged = true;
+  int restarts = 0;
+  long long solves = 0;
+};
+
+struct BandSettings {
+  int wanted;    // pairs nearest sigma to converge
+  int block;     // columns per block
+  int subspace;  // maximal basis size
+  double tolerance;
+  int max_restarts;
+};
+
+// Replaces the first k columns of V by V[:, :k] Z (k x c), c <= k, in place, a block of rows at a
+// time, so that no second n x k buffer is needed.
+void multiply_in_place(Mat& V, int k, const Mat& Z) {
+  constexpr int kRows = 2048;
+  Mat chunk;
+  for (Eigen::Index r = 0; r < V.rows(); r += kRows) {
+    const Eigen::Index rows = std::min<Eigen::Index>(kRows, V.rows() - r);
+    chunk.noalias() = V.block(r, 0, rows, k) * Z;
+    V.block(r, 0, rows, Z.cols()) = chunk;
+  }
+}
+
+// Shift-invert block Krylov-Schur (Stewart 2001, in block form) for the `wanted` eigenpairs of
+// K h = lambda M h nearest to op.sigma(), in the M-orthogonal complement of the pairs already
+// found. Every block is deflated against `near` (found pairs close enough to sigma to be
+// amplified by the shift-invert); the result is made orthogonal to all of `found` at the end.
+// With A = (K - sigma M)^-1 M it maintains the Krylov relation
+//     A V = V T + Q F^T,    V^T M V = I,  Q^T M Q = I,  V^T M Q = 0,
+// so Ritz pairs (theta, y = V z) of T have the residual A y - theta y = Q F^T z for free, and
+// A y / theta = y + Q F^T z / theta is one step of inverse iteration, also for free.
+BandResult solve_band(const ShiftInvert& op, const MassOperator& M, const Basis& found,
+                      const Basis& near, const BandSettings& set, std::mt19937_64& rng) {
+  const int n = static_cast<int>(M.matrix().rows());
+  const int b = set.block, s = set.subspace;
+  const double sigma = op.sigma();
+  Mat V(n, s);
+  Mat T(0, 0), F(0, b);
+  int k = 0;
+  Mat Q = random_block(n, b, rng);
+  orthonormalize(Q, {found}, M, rng);
+  BandResult out;
+  for (;;) {
+    while (k + b <= s) {
+      V.middleCols(k, b) = Q;
+      Mat W = op.solve(M.apply(Q));
+      out.solves += b;
+      // W = V C + Q' R: block Gram-Schmidt (twice), then within the block.
+      Mat C = Mat::Zero(k + b, b);
+      for (int pass = 0; pass < 2; ++pass) {
+        const Mat D = V.leftCols(k + b).transpose() * M.apply(W);
+        W.noalias() -= V.leftCols(k + b) * D;
+        C += D;
+      }
+      if (near.cols() > 0) W.noalias() -= near * (near.transpose() * M.apply(W));
+      Mat R = Mat::Zero(b, b);
+      for (int j = 0; j < b; ++j) {
+        const double norm0 = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
+        for (int pass = 0; pass < 2 && j > 0; ++pass) {
+          const Vec c = W.leftCols(j).transpose() * M.apply(W.col(j)).col(0);
+          W.col(j) -= W.leftCols(j) * c;
+          R.col(j).head(j) += c;
+        }
+        const double norm = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
+        if (norm > 1e-10 * norm0 && norm > 0.0) {
+          R(j, j) = norm;
+          W.col(j) /= norm;
+        } else {  // invariant subspace found: continue with a fresh direction
+          Mat fresh = random_block(n, 1, rng);
+          orthonormalize(fresh, {found, V.leftCols(k + b), W.leftCols(j)}, M, rng);
+          W.col(j) = fresh.col(0);
+          R.col(j).setZero();
+        }
+      }
+      Mat Tn = Mat::Zero(k + b, k + b);
+      Tn.topLeftCorner(k, k) = T;
+      Tn.bottomLeftCorner(b, k) = F.transpose();
+      Tn.rightCols(b) = C;
+      T = 0.5 * (Tn + Tn.transpose());
+      F = Mat::Zero(k + b, b);
+      F.bottomRows(b) = R.transpose();
+      Q = std::move(W);
+      k += b;
+    }
+    Eigen::SelfAdjointEigenSolver<Mat> eig(T);
+    std::vector<int> order(k);
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](int i, int j) {
+      return std::abs(eig.eigenvalues()[i]) > std::abs(eig.eigenvalues()[j]);
+    });
+    const int keep = std::min(s - b, std::max(set.wanted + b, (set.wanted + s) / 2));
+    Mat Z(k, keep);
+    Vec theta(keep);
+    for (int i = 0; i < keep; ++i) {
+      Z.col(i) = eig.eigenvectors().col(order[i]);
+      theta[i] = eig.eigenvalues()[order[i]];
+    }
+    const Mat FZ = F.transpose() * Z;  // b x keep: Ritz residuals in the basis Q
+    int converged = 0;
+    while (converged < keep) {
+      // The refined vector A y / theta has the residual ||r||_M / theta^2 (see eigen_residual).
+      const double t = theta[converged];
+      const double lambda = sigma + 1.0 / t;
+      if (!(FZ.col(converged).norm() <= set.tolerance * std::max(std::abs(lambda), 1.0) * t * t))
+        break;
+      ++converged;
+    }
+    if (converged >= set.wanted || out.restarts >= set.max_restarts) {
+      out.converged = converged >= set.wanted;
+      const int count = std::max(converged, std::min(set.wanted, keep));
+      Mat G = V.leftCols(k) * Z.leftCols(count);
+      G.noalias() += Q * (FZ.leftCols(count) * theta.head(count).cwiseInverse().asDiagonal());
+      orthonormalize(G, {found}, M, rng);
+      out.H = std::move(G);
+      out.lambda = (sigma + theta.head(count).cwiseInverse().array()).matrix();
+      return out;
+    }
+    ++out.restarts;  // thick restart with the `keep` best Ritz vectors
+    multiply_in_place(V, k, Z);
+    T = theta.asDiagonal();
+    F = FZ.transpose();
+    k = keep;
+  }
+}
+
+// Rayleigh-Ritz of (K, M) on the span of H: an M-orthonormal basis of eigenvector
+// approximations, sorted ascending.
+void rayleigh_ritz(const Sparse& K, const MassOperator& M, Mat& H, Vec& lambda) {
+  const Mat A = H.transpose() * (K * H);
+  const Mat B = H.transpose() * M.apply(H);
+  Eigen::GeneralizedSelfAdjointEigenSolver<Mat> eig(0.5 * (A + A.transpose()),
+                                                    0.5 * (B + B.transpose()));
+  if (eig.info() != Eigen::Success) throw SolverError("Rayleigh-Ritz step failed");
+  H = H * eig.eigenvectors();
+  lambda = eig.eigenvalues();
+}
+
+// Adapters that make the CHOLMOD shift-invert operator and M usable by Spectra.
+class SpectraShiftInvertOp {
+ public:
+  using Scalar = double;
+  SpectraShiftInvertOp(const Sparse& K, const Sparse& M) : K_(K), M_(M) {}
+  Eigen::Index rows() const { return K_.rows(); }
+  Eigen::Index cols() const { return K_.cols(); }
+  void set_shift(double sigma) {
+    op_.emplace(K_, M_, sigma, rng_);
+    if (!op_->usable()) throw SolverError("factorization of K - sigma M failed");
+  }
+  void perform_op(const double* x, double* y) const {
+    Eigen::Map<Vec>(y, rows()) = op_->solve(Eigen::Map<const Vec>(x, rows()));
+    ++solves_;
+  }
+  long long solves() const { return solves_; }
+
+ private:
+  const Sparse& K_;
+  const Sparse& M_;
+  std::optional<ShiftInvert> op_;
+  std::mt19937_64 rng_{1};
+  mutable long long solves_ = 0;
+};
+
+class SpectraMassOp {
+ public:
+  using Scalar = double;
+  explicit SpectraMassOp(const Sparse& M) : M_(M) {}
+  Eigen::Index rows() const { return M_.rows(); }
+  Eigen::Index cols() const { return M_.cols(); }
+  void perform_op(const double* x, double* y) const {
+    Eigen::Map<Vec>(y, rows()) = M_ * Eigen::Map<const Vec>(x, rows());
+  }
+
+ private:
+  const Sparse& M_;
+};
+
+void report(const ManifoldHarmonicsOptions& o, double fraction, std::string_view stage) {
+  if (o.progress) o.progress(std::clamp(fraction, 0.0, 1.0), stage);
+}
+
+// Unit-area scale: eigenvalues and basis for K, M / area.
+struct Spectrum {
+  Vec lambda;
+  Mat H;
+  SolveStatus status = SolveStatus::Converged;
+  int bands = 0, restarts = 0;
+  long long solves = 0;
+  bool cluster_truncated = false;
+};
+
+// lambda_m and the next eigenvalue are equal up to round-off and discretisation noise.
+bool same_eigenvalue(double a, double b) {
+  return std::abs(a - b) <= 1e-6 * std::max(1.0, std::abs(b));
+}
+
+Spectrum solve_dense(const Sparse& K, const Sparse& M, int m) {
+  Eigen::GeneralizedSelfAdjointEigenSolver<Mat> eig{Mat(K), Mat(M)};
+  if (eig.info() != Eigen::Success) throw SolverError("dense generalized eigensolver failed");
+  Spectrum out{eig.eigenvalues().head(m), eig.eigenvectors().leftCols(m)};
+  out.bands = 1;
+  out.cluster_truncated = m < K.rows() && same_eigenvalue(out.lambda[m - 1], eig.eigenvalues()[m]);
+  return out;
+}
+
+Spectrum solve_lanczos(const Sparse& K, const Sparse& M, int m, const ManifoldHarmonicsOptions& o) {
+  SpectraShiftInvertOp op(K, M);
+  SpectraMassOp mass(M);
+  const int n = static_cast<int>(K.rows());
+  const int ncv = std::min(n, 2 * m + 1);
+  Spectra::SymGEigsShiftSolver<SpectraShiftInvertOp, SpectraMassOp, Spectra::GEigsMode::ShiftInvert>
+      eigs(op, mass, m, ncv, o.shift);
+  eigs.init();
+  report(o, 0.1, "Lanczos");
+  eigs.compute(Spectra::SortRule::LargestMagn, 10 * o.max_restarts, o.tolerance,
+               Spectra::SortRule::SmallestAlge);
+  Spectrum out{eigs.eigenvalues(), eigs.eigenvectors()};
+  out.status = eigs.info() == Spectra::CompInfo::Successful ? SolveStatus::Converged
+                                                            : SolveStatus::NotConverged;
+  out.bands = 1;
+  out.restarts = static_cast<int>(eigs.num_iterations());
+  out.solves = op.solves();
+  return out;
+}
+
+// Residual of each pair on the unit-area scale (see eigen_residual).
+Vec pair_residuals(const Sparse& K, const Sparse& M, const Mat& H, const Vec& lambda) {
+  const double area = M.sum();
+  const Vec d_inv = (M * Vec::Ones(M.rows())).cwiseInverse();
+  Vec out(H.cols());
+  constexpr int kColumns = 64;  // in blocks, to bound the temporaries
+  for (Eigen::Index j = 0; j < H.cols(); j += kColumns) {
+    const Eigen::Index c = std::min<Eigen::Index>(kColumns, H.cols() - j);
+    const Mat R =
+        K * H.middleCols(j, c) - (M * H.middleCols(j, c)) * lambda.segment(j, c).asDiagonal();
+    const Vec r = R.cwiseAbs2().transpose() * d_inv;
+    for (Eigen::Index i = 0; i < c; ++i) {
+      out[j + i] = area * std::sqrt(r[i]) / std::max(area * lambda[j + i], 1.0);
+    }
+  }
+  return out;
+}
+
+// The middle of the widest gap between consecutive values of `known` (sorted) around `target`,
+// so that a shift placed there stays clear of eigenvalues already seen.
+double clear_shift(double target, const std::vector<double>& known) {
+  for (size_t i = 0; i + 1 < known.size(); ++i) {
+    if (known[i] <= target && target <= known[i + 1]) return 0.5 * (known[i] + known[i + 1]);
+  }
+  return target;
+}
+
+Spectrum solve_block_krylov(const Sparse& K, const Sparse& Mmat, int m,
+                            const ManifoldHarmonicsOptions& o) {
+  const int n = static_cast<int>(K.rows());
+  const MassOperator M(Mmat);
+  std::mt19937_64 rng(o.seed);
+  const int band = o.band_size > 0 ? o.band_size : std::min(m, 160);
+  Spectrum out;
+  out.H.resize(n, m);
+  out.lambda.resize(m);
+  int count = 0;
+  double sigma = o.shift;
+  double spacing = 4.0 * std::numbers::pi;  // Weyl's law on a closed unit-area surface
+  int retries = 0;
+  const auto retry = [&](double new_sigma) {
+    if (++retries > 8) throw SolverError("band-by-band eigensolver: cannot place the shift");
+    sigma = new_sigma;
+  };
+  while (count < m) {
+    const bool last_band = count + band >= m;
+    BandSettings set;
+    set.wanted = std::min(std::min(band, m - count) + (last_band ? 2 : 0), n - count);  // +2: gap
+    set.block = o.block_size > 0 ? o.block_size : std::clamp(set.wanted / 12, 4, 16);
+    set.subspace = std::min(n - count, set.wanted + std::max(set.wanted, 4 * set.block));
+    set.subspace = std::max(set.block, set.subspace / set.block * set.block);
+    set.tolerance = o.tolerance;
+    set.max_restarts = o.max_restarts;
+    report(o, double(count) / m, "factorization");
+    const ShiftInvert op(K, Mmat, sigma, rng);
+    ++out.bands;
+    if (!op.usable()) {  // the shift sits on an eigenvalue: move it a little
+      retry(sigma + 0.1 * spacing);
+      continue;
+    }
+    report(o, double(count) / m, "eigenvectors");
+    // Found pairs within about twice the band's expected radius of the shift are amplified by
+    // the shift-invert as much as the wanted ones: keep the Krylov space clear of them.
+    const double last =
+        count > 0 ? out.lambda[count - 1] : -std::numeric_limits<double>::infinity();
+    int near = count;
+    while (near > 0 && out.lambda[near - 1] >= sigma - 1.2 * set.wanted * spacing) --near;
+    BandResult r =
+        solve_band(op, M, out.H.leftCols(count), out.H.middleCols(near, count - near), set, rng);
+    out.restarts += r.restarts;
+    out.solves += r.solves;
+    rayleigh_ritz(K, M, r.H, r.lambda);
+    std::vector<double> seen(1, count > 0 ? last : sigma);
+    seen.insert(seen.end(), r.lambda.begin(), r.lambda.end());
+    const Vec residual = pair_residuals(K, Mmat, r.H, r.lambda);
+    if (r.converged && residual.maxCoeff() > 10 * o.tolerance) {
+      // Inaccurate solves broke the Krylov relation (a shift close to an eigenvalue): redo the
+      // band with the shift in a gap between the eigenvalues seen.
+      retry(clear_shift(sigma, seen));
+      continue;
+    }
+    double radius = 0.0;
+    for (int i = 0; i < r.lambda.size(); ++i)
+      radius = std::max(radius, std::abs(r.lambda[i] - sigma));
+    if (count > 0 && r.converged && sigma - radius > last + 1e-9 * std::max(1.0, std::abs(last))) {
+      // The band does not reach down to the pairs already found: eigenvalues in between could
+      // be missed. Move the shift down and redo the band.
+      retry(clear_shift(last + 0.5 * (sigma - last), seen));
+      continue;
+    }
+    retries = 0;
+    if (!r.converged) out.status = SolveStatus::NotConverged;
+    const int first_new = count;
+    const int take = std::min<int>(static_cast<int>(r.lambda.size()), m - count);
+    out.H.middleCols(count, take) = r.H.leftCols(take);
+    out.lambda.segment(count, take) = r.lambda.head(take);
+    count += take;
+    if (count == m && take < r.lambda.size()) {
+      out.cluster_truncated = same_eigenvalue(out.lambda[m - 1], r.lambda[take]);
+    }
+    if (count > first_new + 1) {
+      spacing = (out.lambda[count - 1] - out.lambda[first_new]) / (count - first_new - 1);
+    }
+    // The next band's window (radius about band/2 spacings) reaches below the last pair found.
+    sigma = out.lambda[count - 1] + 0.35 * band * std::max(spacing, 1e-6);
+  }
+  return out;
+}
+
+}  // namespace
+
+double eigen_residual(const Sparse& K, const Sparse& M, const Mat& H, const Vec& lambda) {
+  return H.cols() == 0 ? 0.0 : pair_residuals(K, M, H, lambda).maxCoeff();
+}
+
+double orthonormality_error(const Sparse& M, const Mat& H) {
+  const MassOperator op(M);
+  double worst = 0.0;
+  constexpr int kColumns = 128;  // lower triangle of H^T M H, a block column at a time
+  for (Eigen::Index j = 0; j < H.cols(); j += kColumns) {
+    const Eigen::Index c = std::min<Eigen::Index>(kColumns, H.cols() - j);
+    Mat G = H.rightCols(H.cols() - j).transpose() * op.apply(H.middleCols(j, c));
+    G.topRows(c) -= Mat::Identity(c, c);
+    worst = std::max(worst, G.cwiseAbs().maxCoeff());
+  }
+  return worst;
+}
+
+ManifoldHarmonics compute_manifold_harmonics(const Sparse& K, const Sparse& M,
+                                             const ManifoldHarmonicsOptions& o) {
+  const int n = static_cast<int>(K.rows());
+  const int m = o.num_modes;
+  if (K.rows() != K.cols() || M.rows() != n || M.cols() != n) {
+    throw InputError("manifold harmonics: K and M must be square matrices of the same size");
+  }
+  if (m < 1 || m > n) {
+    throw InputError("manifold harmonics: the number of modes must be in [1, " + std::to_string(n) +
+                     "] for this mesh, got " + std::to_string(m));
+  }
+  if (!(o.shift < 0.0)) throw InputError("manifold harmonics: the shift must be negative");
+  if (!(o.tolerance > 0.0)) throw InputError("manifold harmonics: the tolerance must be positive");
+  const Vec row_sums = M * Vec::Ones(n);
+  const int massless = static_cast<int>((row_sums.array() <= 0.0).count());
+  if (massless > 0) {
+    throw InputError("manifold harmonics: " + std::to_string(massless) +
+                     " vertices have zero area (only degenerate faces touch them)");
+  }
+  const double area = row_sums.sum();
+  const Sparse M_unit = M / area;
+
+  Spectrum s;
+  const bool dense = n <= kDenseLimit || 3 * m > 2 * n;
+  if (dense) {
+    if (n > 6000) {
+      throw InputError("manifold harmonics: m = " + std::to_string(m) + " is too close to n = " +
+                       std::to_string(n) + " for an iterative solver; use m <= 2n/3");
+    }
+    report(o, 0.0, "dense eigensolver");
+    s = solve_dense(K, M_unit, m);
+  } else if (o.solver == EigenSolver::Lanczos) {
+    s = solve_lanczos(K, M_unit, m, o);
+  } else {
+    s = solve_block_krylov(K, M_unit, m, o);
+  }
+  ManifoldHarmonics out;
+  out.status = s.status;
+  out.cluster_truncated = s.cluster_truncated;
+  out.bands = s.bands;
+  out.restarts = s.restarts;
+  out.solves = s.solves;
+  out.eigenvalues = s.lambda / area;
+  out.basis = std::move(s.H);
+  out.basis /= std::sqrt(area);
+  for (int j = 0; j < m; ++j) {  // sign convention: largest-magnitude entry positive
+    Eigen::Index i;
+    out.basis.col(j).cwiseAbs().maxCoeff(&i);
+    if (out.basis(i, j) < 0) out.basis.col(j) *= -1.0;
+  }
+  report(o, 1.0, "verification");
+  out.max_residual = eigen_residual(K, M, out.basis, out.eigenvalues);
+  out.max_orthogonality_error = orthonormality_error(M, out.basis);
+  if (out.max_residual > o.tolerance * 100) out.status = SolveStatus::NotConverged;
+  return out;
+}
+
+ManifoldHarmonics compute_manifold_harmonics(const TriangleMesh& mesh,
+                                             const ManifoldHarmonicsOptions& options) {
+  ManifoldHarmonics h =
+      compute_manifold_harmonics(cotan_stiffness(mesh), mass_matrix(mesh, options.mass), options);
+  h.mass = options.mass;
+  return h;
+}
+
+}  // namespace specdeform

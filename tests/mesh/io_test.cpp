@@ -1,0 +1,279 @@
+#include "specdeform/mesh/io.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include "specdeform/exceptions.h"
+#include "specdeform/mesh/generate.h"
+#include "support/corpus.h"
+
+namespace specdeform {
+namespace {
+
+LoadedMesh parse(std::string_view text, MeshFormat format) {
+  return read_mesh_from_memory(text, format, "test");
+}
+
+// Expects an InputError whose message contains `fragment`.
+void expect_error(std::string_view text, MeshFormat format, const std::string& fragment) {
+  try {
+    parse(text, format);
+    ADD_FAILURE() << "no error, expected '" << fragment << "'";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << "one line: " << e.what();
+  }
+}
+
+TriangleMesh awkward_coordinates() {
+  TriangleMesh m = make_icosphere(1);
+  m.V(0, 0) = 0.1;
+  m.V(1, 1) = 1.0 / 3.0;
+  m.V(2, 2) = -std::numeric_limits<double>::denorm_min();
+  m.V(3, 0) = 1e300;
+  return m;
+}
+
+TEST(MeshIo, RoundTripIsExactForDoubleFormats) {
+  const TriangleMesh m = awkward_coordinates();
+  for (const MeshFormat f : {MeshFormat::Obj, MeshFormat::Off, MeshFormat::Ply}) {
+    const LoadedMesh back = parse(encode_mesh(m, f), f);
+    EXPECT_EQ(back.mesh.V, m.V) << static_cast<int>(f);
+    EXPECT_EQ(back.mesh.F, m.F) << static_cast<int>(f);
+  }
+}
+
+TEST(MeshIo, StlRoundTripWeldsCornersAndKeepsTriangles) {
+  const TriangleMesh m = make_icosphere(2);
+  const LoadedMesh back = parse(encode_mesh(m, MeshFormat::Stl), MeshFormat::Stl);
+  ASSERT_EQ(back.mesh.num_vertices(), m.num_vertices());
+  ASSERT_EQ(back.mesh.num_faces(), m.num_faces());
+  EXPECT_EQ(back.info.welded_corners, 3 * m.num_faces() - m.num_vertices());
+  for (int f = 0; f < m.num_faces(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::RowVector3d p = m.V.row(m.F(f, k));
+      EXPECT_LT((back.mesh.V.row(back.mesh.F(f, k)) - p).norm(), 1e-6);
+    }
+  }
+}
+
+TEST(MeshIo, WriteIsAtomicAndReadable) {
+  const auto dir = std::filesystem::temp_directory_path() / "specdeform_io_test";
+  std::filesystem::create_directories(dir);
+  const TriangleMesh m = make_torus(1.0, 0.3, 12, 6);
+  for (const char* ext : {".obj", ".off", ".ply", ".stl", ".OBJ"}) {
+    const auto path = dir / (std::string("torus") + ext);
+    write_mesh(path, m);
+    EXPECT_EQ(read_mesh(path).mesh.num_faces(), m.num_faces()) << ext;
+  }
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    EXPECT_NE(entry.path().filename().string()[0], '.') << "temporary file left behind";
+  }
+  EXPECT_THROW(write_mesh(dir / "torus.xyz", m), InputError);
+  EXPECT_THROW(write_mesh(dir / "missing" / "torus.obj", m), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(MeshIo, ObjForms) {
+  const char* text =
+      "# comment\nmtllib none.mtl\no thing\nv 0 0 0\nv 1 0 0 0.5 0.5 0.5\nv 1 1 0\nv 0 1 0\n"
+      "vt 0 0\nvn 0 0 1\ng group\nusemtl m\ns 1\n"
+      "f 1/1/1 2/1/1 3/1/1 4/1/1\n"    // a quad, with v/vt/vn
+      "v 0 0 1\nf -1 1// \\\n 2//1\n"  // negative index, v//vn, line continuation
+      "f 1/1/ 3/1/ 5/1/\n"             // v/vt/ with an empty normal
+      "l 1 2\n";
+  const LoadedMesh m = parse(text, MeshFormat::Obj);
+  EXPECT_EQ(m.mesh.num_vertices(), 5);
+  EXPECT_EQ(m.mesh.num_faces(), 4);
+  EXPECT_EQ(m.info.file_faces, 3);
+  EXPECT_EQ(m.mesh.F.row(2), Eigen::RowVector3i(4, 0, 1));
+  EXPECT_EQ(m.info.face_to_file, (std::vector<int>{0, 0, 1, 2}));
+}
+
+TEST(MeshIo, OffVariants) {
+  const char* variants[] = {
+      "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
+      "OFF 4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
+      "# a comment\nCOFF\n4 2 5\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n1 1 0 0 0 0 1\n"
+      "0 1 0 1 1 1 1\n3 0 1 2 255 0 0\n3 0 2 3\n",
+      "NOFF\n# counts\n4 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n4 0 1 2 3\n",
+      "4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
+  };
+  for (const char* text : variants) {
+    const LoadedMesh m = parse(text, MeshFormat::Off);
+    EXPECT_EQ(m.mesh.num_vertices(), 4) << text;
+    EXPECT_EQ(m.mesh.num_faces(), 2) << text;
+  }
+}
+
+// A tetrahedron as PLY with the given encoding, coordinate type and index types.
+std::string tetra_ply(const std::string& format, const std::string& coord, const std::string& count,
+                      const std::string& index) {
+  std::string s = "ply\nformat " + format + " 1.0\ncomment test\nelement vertex 4\n";
+  s += "property " + coord + " x\nproperty uchar red\nproperty " + coord + " y\nproperty " + coord +
+       " z\n";
+  s += "element face 4\nproperty list " + count + " " + index + " vertex_indices\n";
+  s += "property float quality\nelement edge 1\nproperty int v1\nproperty int v2\nend_header\n";
+  const int pts[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const int tris[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
+  if (format == "ascii") {
+    for (const auto& p : pts)
+      s += std::to_string(p[0]) + " 7 " + std::to_string(p[1]) + " " + std::to_string(p[2]) + "\n";
+    for (const auto& t : tris)
+      s += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) +
+           " 0.5\n";
+    return s + "0 1\n";
+  }
+  const bool big = format == "binary_big_endian";
+  const auto put = [&](const std::string& type, double v) {
+    unsigned char b[8];
+    size_t size = 0;
+    const auto store = [&](auto x) {
+      size = sizeof(x);
+      std::memcpy(b, &x, size);
+    };
+    if (type == "uchar" || type == "uint8") store(static_cast<uint8_t>(v));
+    if (type == "char" || type == "int8") store(static_cast<int8_t>(v));
+    if (type == "short" || type == "int16") store(static_cast<int16_t>(v));
+    if (type == "ushort" || type == "uint16") store(static_cast<uint16_t>(v));
+    if (type == "int" || type == "int32") store(static_cast<int32_t>(v));
+    if (type == "uint" || type == "uint32") store(static_cast<uint32_t>(v));
+    if (type == "float" || type == "float32") store(static_cast<float>(v));
+    if (type == "double" || type == "float64") store(static_cast<double>(v));
+    if (big) std::reverse(b, b + size);
+    s.append(reinterpret_cast<const char*>(b), size);
+  };
+  for (const auto& p : pts) {
+    put(coord, p[0]);
+    put("uchar", 7);
+    put(coord, p[1]);
+    put(coord, p[2]);
+  }
+  for (const auto& t : tris) {
+    put(count, 3);
+    for (const int v : t) put(index, v);
+    put("float", 0.5);
+  }
+  put("int", 0);
+  put("int", 1);
+  return s;
+}
+
+TEST(MeshIo, PlyEncodingsAndTypes) {
+  for (const char* format : {"ascii", "binary_little_endian", "binary_big_endian"}) {
+    for (const char* coord : {"float", "double", "short", "int8", "uint16"}) {
+      for (const char* index : {"int", "uint", "ushort", "uchar", "int32"}) {
+        const LoadedMesh m = parse(tetra_ply(format, coord, "uchar", index), MeshFormat::Ply);
+        ASSERT_EQ(m.mesh.num_vertices(), 4) << format << coord << index;
+        ASSERT_EQ(m.mesh.num_faces(), 4);
+        EXPECT_EQ(m.mesh.V.row(3), Eigen::RowVector3d(0, 0, 1)) << format << coord << index;
+        EXPECT_EQ(m.mesh.F.row(2), Eigen::RowVector3i(1, 2, 3));
+      }
+    }
+  }
+  EXPECT_EQ(parse(tetra_ply("binary_big_endian", "float", "int", "int"), MeshFormat::Ply)
+                .mesh.num_faces(),
+            4);
+}
+
+TEST(MeshIo, StlAsciiAndBinary) {
+  const char* ascii =
+      "solid thing\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+      "endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 1 1 0\n"
+      "vertex 0 1 0\nendloop\nendfacet\nendsolid thing\nsolid second\nfacet normal 0 0 1\n"
+      "outer loop\nvertex 5 0 0\nvertex 6 0 0\nvertex 5 1 0\nendloop\nendfacet\nendsolid\n";
+  const LoadedMesh m = parse(ascii, MeshFormat::Stl);
+  EXPECT_EQ(m.mesh.num_faces(), 3);
+  EXPECT_EQ(m.mesh.num_vertices(), 7);
+  EXPECT_EQ(m.info.welded_corners, 2);
+  // A binary file whose header starts with "solid" is still binary.
+  std::string binary = encode_mesh(make_icosphere(0), MeshFormat::Stl);
+  binary.replace(0, 5, "solid");
+  EXPECT_EQ(parse(binary, MeshFormat::Stl).mesh.num_vertices(), 12);
+}
+
+TEST(MeshIo, UnusedVerticesAreDroppedAndRestored) {
+  const char* text = "OFF\n5 2 0\n9 9 9\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 1 2 3\n3 1 3 4\n";
+  const LoadedMesh m = parse(text, MeshFormat::Off);
+  EXPECT_EQ(m.mesh.num_vertices(), 4);
+  EXPECT_EQ(m.info.unused_vertices, 1);
+  EXPECT_EQ(m.info.vertex_to_file, (std::vector<int>{1, 2, 3, 4}));
+  Vertices moved = m.mesh.V;
+  moved.col(2).array() += 1.0;
+  const TriangleMesh back = to_file_order(m.info, moved, m.mesh.F);
+  EXPECT_EQ(back.V.row(0), Eigen::RowVector3d(9, 9, 9));
+  EXPECT_EQ(back.V.row(4), Eigen::RowVector3d(0, 1, 1));
+  EXPECT_EQ(back.F.row(1), Eigen::RowVector3i(1, 3, 4));
+}
+
+TEST(MeshIo, FacesRepeatingAVertexAreDropped) {
+  const LoadedMesh m =
+      parse("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 1\n", MeshFormat::Off);
+  EXPECT_EQ(m.mesh.num_faces(), 1);
+  EXPECT_EQ(m.info.collapsed_faces, 1);
+}
+
+TEST(MeshIo, ClearErrors) {
+  expect_error("", MeshFormat::Off, "empty file");
+  expect_error("OFF\n", MeshFormat::Off, "unexpected end of file");
+  expect_error("OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n", MeshFormat::Off, "no faces");
+  expect_error("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n", MeshFormat::Off, "vertex 7");
+  expect_error("OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n", MeshFormat::Off, "NaN");
+  expect_error("OFF\n3 1 0\n0 0 0\ninf 0 0\n0 1 0\n3 0 1 2\n", MeshFormat::Off, "NaN or infinite");
+  expect_error("OFF\n3 1 0\n0 0 0\n1 0 0\n", MeshFormat::Off, "unexpected end of file");
+  expect_error("4OFF\n", MeshFormat::Off, "unsupported OFF variant");
+  expect_error("OFF\n100000000000 1 0\n", MeshFormat::Off, "more vertices");
+  expect_error("", MeshFormat::Obj, "empty file");
+  expect_error("v 0 0 0\nv 1 0 0\nv 0 1 0\n", MeshFormat::Obj, "no faces");
+  expect_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", MeshFormat::Obj, "references vertex 4");
+  expect_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", MeshFormat::Obj, "bad face corner");
+  expect_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -4 1 2\n", MeshFormat::Obj, "references vertex -4");
+  expect_error("ply\nformat ascii 1.0\nend_header\n", MeshFormat::Ply, "no vertices");
+  expect_error(
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n",
+      MeshFormat::Ply, "no faces");
+  std::string truncated = tetra_ply("binary_little_endian", "float", "uchar", "int");
+  truncated.resize(truncated.size() - 20);
+  expect_error(truncated, MeshFormat::Ply, "truncated");
+  expect_error("ply\nformat ascii 1.0\n", MeshFormat::Ply, "end_header");
+  std::string stl = encode_mesh(make_icosphere(0), MeshFormat::Stl);
+  stl.resize(stl.size() - 10);
+  expect_error(stl, MeshFormat::Stl, "truncated binary STL");
+  expect_error("solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n", MeshFormat::Stl,
+               "truncated");
+  EXPECT_THROW(read_mesh("/nonexistent/file.obj"), InputError);
+  EXPECT_THROW(read_mesh("mesh.dae"), InputError);
+}
+
+// Every file of ../shared/meshes/awkward gives a mesh or one clear error line.
+TEST(MeshIo, AwkwardCorpus) {
+  const auto shared = test::shared_dir();
+  if (shared.empty()) GTEST_SKIP() << "../shared is absent: awkward corpus not available";
+  int loaded = 0, rejected = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(shared / "meshes" / "awkward")) {
+    try {
+      const LoadedMesh m = read_mesh(entry.path());
+      EXPECT_GT(m.mesh.num_faces(), 0);
+      EXPECT_TRUE(m.mesh.V.allFinite());
+      EXPECT_GE(m.mesh.F.minCoeff(), 0);
+      EXPECT_LT(m.mesh.F.maxCoeff(), m.mesh.num_vertices());
+      ++loaded;
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+      EXPECT_NE(std::string(e.what()).find(entry.path().filename().string()), std::string::npos);
+      ++rejected;
+    }
+  }
+  EXPECT_EQ(loaded, 16);  // all but the five empty or face-less files
+  EXPECT_EQ(rejected, 5);
+}
+
+}  // namespace
+}  // namespace specdeform

@@ -1,0 +1,61 @@
+#include "specdeform/spectral/basis_cache.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "specdeform/exceptions.h"
+#include "specdeform/mesh/generate.h"
+
+namespace specdeform {
+namespace {
+
+class BasisCache : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    // One folder per test: ctest runs the tests of this fixture in parallel.
+    dir_ = std::filesystem::temp_directory_path() /
+           ("specdeform_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    std::filesystem::create_directories(dir_);
+    mesh_ = make_torus(1.0, 0.35, 40, 12);
+    ManifoldHarmonicsOptions o;
+    o.num_modes = 20;
+    h_ = compute_manifold_harmonics(mesh_, o);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  std::filesystem::path dir_;
+  TriangleMesh mesh_;
+  ManifoldHarmonics h_;
+};
+
+TEST_F(BasisCache, RoundTrip) {
+  save_basis(dir_ / "b.sdbasis", h_, mesh_);
+  const ManifoldHarmonics back = load_basis(dir_ / "b.sdbasis", mesh_);
+  EXPECT_EQ(back.basis, h_.basis);
+  EXPECT_EQ(back.eigenvalues, h_.eigenvalues);
+  EXPECT_EQ(back.mass, MassType::Lumped);
+  save_basis(dir_ / "f.sdbasis", h_, mesh_, BasisPrecision::Float32);
+  const ManifoldHarmonics single = load_basis(dir_ / "f.sdbasis", mesh_);
+  EXPECT_LT((single.basis - h_.basis).cwiseAbs().maxCoeff(), 1e-6 * h_.basis.cwiseAbs().maxCoeff());
+  EXPECT_LT(std::filesystem::file_size(dir_ / "f.sdbasis"),
+            0.6 * std::filesystem::file_size(dir_ / "b.sdbasis"));
+}
+
+TEST_F(BasisCache, RefusesAnotherMeshOrABrokenFile) {
+  save_basis(dir_ / "b.sdbasis", h_, mesh_);
+  TriangleMesh moved = mesh_;
+  moved.V(3, 1) += 1e-12;
+  EXPECT_THROW(load_basis(dir_ / "b.sdbasis", moved), InputError);
+  EXPECT_THROW(load_basis(dir_ / "b.sdbasis", make_torus(1.0, 0.35, 40, 13)), InputError);
+  std::filesystem::resize_file(dir_ / "b.sdbasis", 1000);
+  EXPECT_THROW(load_basis(dir_ / "b.sdbasis", mesh_), InputError);
+  std::ofstream(dir_ / "junk.sdbasis") << "not a basis at all, but long enough for a header";
+  EXPECT_THROW(load_basis(dir_ / "junk.sdbasis", mesh_), InputError);
+  EXPECT_THROW(load_basis(dir_ / "missing.sdbasis", mesh_), InputError);
+}
+
+}  // namespace
+}  // namespace specdeform
