@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   specdeform::cli::add_smooth_command(app);
   specdeform::cli::add_generate_command(app);
   specdeform::cli::add_subdivide_command(app);
+  specdeform::cli::add_deform_command(app);
   specdeform::cli::add_demo_command(app);
   try {
     app.parse(argc, argv);

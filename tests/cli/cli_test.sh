@@ -32,5 +32,25 @@ expect 1 "$bin" info "$tmp/trunc.off"
 expect 1 "$bin" basis "$tmp/s.off" -m 100000
 expect 1 "$bin" smooth "$tmp/fine.obj" -m 9 --basis "$tmp/s.sdbasis" -o "$tmp/x.obj"
 [ -e "$tmp/x.obj" ] && { echo "FAIL: output written despite an error"; fails=$((fails + 1)); }
+# deform: a JSON scene, the Botsch-Sorkine files, errors
+"$bin" generate bumpy-plane --resolution 16 -o "$tmp/p.off" >/dev/null
+printf '{"handles": [{"vertices": [288], "transform": {"translate": [0, 0, 0.2]}}], "fixed": [0, 1, 2, 16]}' >"$tmp/scene.json"
+expect 0 "$bin" deform "$tmp/p.off" --scene "$tmp/scene.json" -m 30 -o "$tmp/d.off" --json --repeat 3
+grep -q '"constraint_error"' "$tmp/out" || { echo "FAIL: deform --json lacks constraint_error"; fails=$((fails + 1)); }
+awk 'NR==1{print "# sel"} NR>1{}' /dev/null >"$tmp/p.sel"
+for i in $(seq 0 288); do if [ "$i" -lt 17 ]; then echo 0; elif [ "$i" -gt 271 ]; then echo 2; else echo 1; fi; done >>"$tmp/p.sel"
+printf '# lift\n1 0 0 0\n0 1 0 0\n0 0 1 0.2\n0 0 0 1\n' >"$tmp/p.def"
+expect 0 "$bin" deform "$tmp/p.off" --sel "$tmp/p.sel" --def "$tmp/p.def" -m 30 -o "$tmp/d.obj"
+expect 0 "$bin" deform "$tmp/p.off" --sel "$tmp/p.sel" --def "$tmp/p.def" --solver spatial --detail none -o "$tmp/s.obj"
+expect 2 "$bin" deform "$tmp/p.off" -o "$tmp/x.off"
+expect 2 "$bin" deform "$tmp/p.off" --sel "$tmp/p.sel" -o "$tmp/x.off"
+expect 2 "$bin" deform "$tmp/p.off" --scene "$tmp/scene.json" --detail sideways -o "$tmp/x.off"
+head -5 "$tmp/p.sel" >"$tmp/short.sel"
+expect 1 "$bin" deform "$tmp/p.off" --sel "$tmp/short.sel" --def "$tmp/p.def" -o "$tmp/x.off"
+printf '{"handles": [{"vertices": [9999]}]}' >"$tmp/bad.json"
+expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/bad.json" -o "$tmp/x.off"
+expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/scene.json" --constraints hard -m 3 -o "$tmp/x.off"
+expect 0 "$bin" demo -o "$tmp/demo" -m 40
+[ -s "$tmp/demo/4_deformed.obj" ] || { echo "FAIL: demo wrote no deformed mesh"; fails=$((fails + 1)); }
 [ "$fails" = 0 ] && echo "cli tests passed"
 exit "$fails"

@@ -1,0 +1,176 @@
+#include <algorithm>
+#include <iostream>
+#include <map>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "common.h"
+#include "specdeform/deform/scene.h"
+#include "specdeform/deform/spectral_deformer.h"
+#include "specdeform/exceptions.h"
+
+namespace specdeform::cli {
+
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+}  // namespace
+
+void add_deform_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("deform", "deform a mesh by handles: spectral or spatial solve");
+  struct Args {
+    std::string mesh, output, sel, def, dmat, scene, basis;
+    int modes = 100, repeat = 1;
+    bool json = false;
+    DeformOptions options;
+    ManifoldHarmonicsOptions harmonics;
+  };
+  auto args = std::make_shared<Args>();
+  static const std::map<std::string, DetailMethod> kDetail{
+      {"none", DetailMethod::None},
+      {"displacement", DetailMethod::Displacement},
+      {"frames", DetailMethod::Frames},
+      {"transfer", DetailMethod::Transfer}};
+  static const std::map<std::string, DeformSolver> kSolver{{"spectral", DeformSolver::Spectral},
+                                                           {"spatial", DeformSolver::Spatial}};
+  static const std::map<std::string, ConstraintMode> kConstraints{{"soft", ConstraintMode::Soft},
+                                                                  {"hard", ConstraintMode::Hard}};
+  cmd->add_option("MESH", args->mesh, "mesh file (optional with a --scene that names one)");
+  cmd->add_option("-o,--output", args->output, "deformed mesh to write")->required();
+  auto* sel =
+      cmd->add_option("--sel", args->sel, "Botsch-Sorkine selection (0 fixed, 1 free, 2 handle)");
+  auto* dmat =
+      cmd->add_option("--dmat", args->dmat, "libigl selection (-1 free, k handle group k)");
+  auto* def =
+      cmd->add_option("--def", args->def, "handle transforms: 4x4 row-major, one per group");
+  auto* scene = cmd->add_option("--scene", args->scene, "JSON scene (see docs/scene.md)");
+  sel->excludes(dmat)->excludes(scene)->needs(def);
+  dmat->excludes(scene)->needs(def);
+  def->excludes(scene);
+  cmd->add_option("-m,--modes", args->modes, "manifold harmonics used (default 100)")
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--ks", args->options.ks, "stretching weight (default 0)")->check(kNonNegative);
+  cmd->add_option("--kb", args->options.kb, "bending weight (default 1)")->check(kNonNegative);
+  cmd->add_option("--weight", args->options.constraint_weight,
+                  "soft-constraint weight (default 1e5)")
+      ->check(kPositive);
+  cmd->add_option("--detail", args->options.detail,
+                  "none | displacement | frames | transfer (default)")
+      ->transform(CLI::CheckedTransformer(kDetail, CLI::ignore_case));
+  cmd->add_option("--solver", args->options.solver, "spectral (default) | spatial (reference)")
+      ->transform(CLI::CheckedTransformer(kSolver, CLI::ignore_case));
+  cmd->add_option("--constraints", args->options.constraints, "soft (default) | hard")
+      ->transform(CLI::CheckedTransformer(kConstraints, CLI::ignore_case));
+  cmd->add_flag("--float32", args->options.float32_basis, "single-precision basis in the frame");
+  cmd->add_option("--basis", args->basis,
+                  "basis cache: read if it exists (and matches the mesh), written otherwise");
+  cmd->add_option("--repeat", args->repeat, "solve the frame N times, report medians (default 1)")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_flag("--json", args->json, "print one JSON object with timings and errors");
+  add_harmonics_options(*cmd, args->harmonics);
+  cmd->callback([args, cmd] {
+    if (args->sel.empty() && args->dmat.empty() && args->scene.empty()) {
+      throw CLI::ValidationError("deform", "give --sel and --def, --dmat and --def, or --scene");
+    }
+    // The scene's settings override the defaults; options given on the command line win.
+    DeformOptions options = args->options;
+    int modes = args->modes;
+    Scene scene;
+    std::string mesh_path = args->mesh;
+    LoadedMesh loaded;
+    if (!args->scene.empty()) {
+      if (mesh_path.empty()) {
+        // The mesh is named by the scene: read the scene once for the name, then again with
+        // the mesh's positions (for centroid centres).
+        scene = read_scene(args->scene, Vertices(0, 3));
+        if (scene.mesh.empty())
+          throw InputError(args->scene + ": the scene names no mesh; give MESH");
+        mesh_path = scene.mesh.string();
+      }
+    } else if (mesh_path.empty()) {
+      throw CLI::ValidationError("deform", "MESH is required");
+    }
+    loaded = load_mesh(mesh_path);
+    if (!args->scene.empty()) {
+      scene = read_scene(args->scene, loaded.info.file_vertices, options);
+      const auto keep = [&](const char* flag, auto& field, const auto& from_scene) {
+        if (cmd->count(flag) == 0) field = from_scene;
+      };
+      keep("--ks", options.ks, scene.options.ks);
+      keep("--kb", options.kb, scene.options.kb);
+      keep("--weight", options.constraint_weight, scene.options.constraint_weight);
+      keep("--detail", options.detail, scene.options.detail);
+      keep("--solver", options.solver, scene.options.solver);
+      keep("--constraints", options.constraints, scene.options.constraints);
+      if (cmd->count("--modes") == 0 && scene.modes) modes = *scene.modes;
+    } else {
+      const int nf = static_cast<int>(loaded.info.file_vertices.rows());
+      scene.selection = args->sel.empty() ? read_dmat(args->dmat, nf) : read_sel(args->sel, nf);
+      scene.transforms = read_def(args->def);
+    }
+    scene.transforms = match_transforms(scene.selection, scene.transforms);
+    const Selection selection = to_mesh_numbering(scene.selection, loaded.info);
+
+    nlohmann::ordered_json timings;
+    ManifoldHarmonics basis;
+    bool loaded_basis = false;
+    if (options.solver == DeformSolver::Spectral) {
+      ManifoldHarmonicsOptions h = args->harmonics;
+      h.num_modes = modes;
+      const Stopwatch clock;
+      basis = obtain_basis(loaded.mesh, h, args->basis, &loaded_basis);
+      timings["basis"] = clock.seconds();
+    } else {
+      timings["basis"] = 0.0;
+    }
+    SpectralDeformer deformer(loaded.mesh, std::move(basis), options);
+    deformer.set_selection(selection);
+    Vertices result;
+    std::vector<double> reduced, inverse, detail, total;
+    for (int r = 0; r < args->repeat; ++r) {
+      result = deformer.solve(scene.transforms);
+      const FrameTimings& f = deformer.frame_timings();
+      reduced.push_back(f.reduced_solve);
+      inverse.push_back(f.inverse_transform);
+      detail.push_back(f.detail);
+      total.push_back(f.total);
+    }
+    if (!result.allFinite()) throw SolverError("the deformation produced non-finite positions");
+    write_mesh(args->output, to_file_order(loaded.info, result, loaded.mesh.F));
+    const SetupTimings& s = deformer.setup_timings();
+    const ConstraintError e = deformer.constraint_error(result);
+    timings["reduced_system"] = s.reduced_system;
+    timings["detail_factorization"] = s.detail_factorization;
+    timings["selection"] = s.selection;
+    timings["frame"] = {{"reduced_solve", median(reduced)},
+                        {"inverse_transform", median(inverse)},
+                        {"detail", median(detail)},
+                        {"total", median(total)}};
+    if (args->json) {
+      nlohmann::ordered_json j;
+      j["vertices"] = loaded.mesh.num_vertices();
+      j["modes"] = options.solver == DeformSolver::Spectral ? modes : 0;
+      j["basis_cached"] = loaded_basis;
+      j["constrained_vertices"] = selection.fixed.size() + [&] {
+        size_t c = 0;
+        for (const auto& g : selection.handles) c += g.size();
+        return c;
+      }();
+      j["timings"] = timings;
+      j["constraint_error"] = {{"max", e.max}, {"rms", e.rms}};
+      j["output"] = args->output;
+      std::cout << j.dump() << "\n";
+    } else {
+      std::cout << "wrote " << args->output << ": frame " << median(total) * 1e3
+                << " ms, constraint error max " << e.max << " rms " << e.rms
+                << " (of the bounding-box diagonal)\n";
+    }
+  });
+}
+
+}  // namespace specdeform::cli

@@ -1,0 +1,54 @@
+// Adding the high-frequency details back (Rong, Cao & Guo 2008, section 4.4).
+//
+// The detailed mesh x (n x 3) and its smooth base s (the low-passed x) share one connectivity.
+// Given the deformed base s', each method returns the deformed detailed mesh x':
+//  - None:         x' = s'.
+//  - Displacement: x' = s' + (x - s); details do not rotate.
+//  - Frames:       x - s in a per-vertex frame of s (vertex normal, first incident edge projected
+//                  to the tangent plane) is re-expressed in the same frame of s'. Rotates
+//                  details; can self-intersect under strong bending.
+//  - Transfer:     deformation transfer (Botsch, Sumner, Pauly & Gross 2006): per triangle the
+//                  gradient S_f = [c'-a', b'-a', n'] [c-a, b-a, n]^-1 of s -> s' (unit normals),
+//                  applied to the gradients of x; then the Poisson system K x' = G^T D [S grad x]
+//                  on the detailed mesh, with the anchors (the constrained vertices) at their
+//                  exact targets. K is analysed once, factored (CHOLMOD, numeric only) once per
+//                  anchor set; a frame is O(f) plus one back-substitution with 3 columns.
+// With s' = s every method returns x (to round-off).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "specdeform/deform/deform_options.h"
+#include "specdeform/mesh/triangle_mesh.h"
+
+namespace specdeform {
+
+class DetailReconstruction {
+ public:
+  DetailReconstruction(const TriangleMesh& detailed, const Vertices& base, DetailMethod method);
+  ~DetailReconstruction();
+  DetailReconstruction(DetailReconstruction&&) noexcept;
+  DetailReconstruction& operator=(DetailReconstruction&&) noexcept;
+
+  // Transfer: factors the Poisson system with these vertices anchored. Other methods: nothing.
+  void set_anchors(const std::vector<int>& vertices);
+
+  // anchor_positions: exact positions of the anchors (n' x 3, Transfer only).
+  Vertices apply(const Vertices& deformed_base, const Eigen::MatrixX3d& anchor_positions) const;
+
+  DetailMethod method() const { return method_; }
+
+  struct Poisson;  // the Transfer method's precomputed system
+
+ private:
+  DetailMethod method_;
+  Faces faces_;
+  Vertices details_;                  // x - s (Displacement), local coordinates (Frames)
+  std::vector<int> frame_neighbour_;  // Frames: the vertex that fixes each tangent
+  std::unique_ptr<Poisson> poisson_;  // Transfer
+};
+
+}  // namespace specdeform

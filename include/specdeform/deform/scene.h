@@ -1,0 +1,66 @@
+// Deformation scenes: which vertices are handles or fixed, and how the handles move.
+//
+// Formats read:
+//  - Botsch & Sorkine benchmark: .sel, one status per file vertex (0 fixed, 1 free, 2 handle),
+//    '#' comment lines; .def, a comment line, then 4 x 4 row-major transforms (one per handle
+//    group; a single one for a .sel).
+//  - libigl selection .dmat: header "cols rows", then one integer per vertex, column-major:
+//    -1 free, k >= 0 handle group k. Groups without a transform in the .def stay put.
+//  - JSON (docs/scene.md):
+//      { "mesh": "bar.off",                        (relative to the scene file; optional)
+//        "handles": [ { "vertices": [1, 2, 3] | "selection": "x.sel" | "selection": "x.dmat",
+//                       "group": 0,                 (for a .dmat; 2 = handle for a .sel)
+//                       "transform": [[4 x 4 rows]] |
+//                         { "translate": [x, y, z],
+//                           "rotate": { "axis": [x, y, z], "degrees": a },
+//                           "scale": s,
+//                           "center": [x, y, z] | "centroid" } } ],   (default: centroid)
+//        "fixed": [4, 5] | { "selection": "x.sel" },  (status 0 of a .sel)
+//        "settings": { "modes": 100, "ks": 0, "kb": 1, "constraint_weight": 1e5,
+//                      "constraints": "soft", "detail": "transfer", "solver": "spectral" } }
+//    The transform of a handle maps p to center + R (scale (p - center)) + translate.
+// Vertex indices are the file's; to_mesh_numbering() maps them to a loaded mesh (whose reader
+// may have dropped unused vertices). Every reader throws InputError with a one-line message.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "specdeform/deform/deform_options.h"
+#include "specdeform/deform/selection.h"
+#include "specdeform/mesh/io.h"
+
+namespace specdeform {
+
+struct Scene {
+  std::filesystem::path mesh;  // empty when the scene does not name one
+  Selection selection;         // in the file's vertex numbering
+  std::vector<Eigen::Affine3d> transforms;
+  std::optional<int> modes;  // settings the scene asks for
+  DeformOptions options;
+};
+
+// .sel: one handle group (status 2) and the fixed set (status 0).
+Selection read_sel(const std::filesystem::path& path, int file_vertices);
+// .dmat: handle group k = the vertices with value k.
+Selection read_dmat(const std::filesystem::path& path, int file_vertices);
+// .def: the transforms, in order.
+std::vector<Eigen::Affine3d> read_def(const std::filesystem::path& path);
+// JSON scene; `file_vertices` are the positions of the mesh's file vertices (for "centroid").
+// `options` are the defaults the scene's settings override.
+Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertices,
+                 const DeformOptions& options = {});
+
+// Pads `transforms` with identities up to the number of handle groups; throws InputError if
+// there are more transforms than groups or the selection has no handle vertex.
+std::vector<Eigen::Affine3d> match_transforms(const Selection& selection,
+                                              std::vector<Eigen::Affine3d> transforms);
+
+// From file vertex indices to the loaded mesh's; vertices the reader dropped are left out.
+Selection to_mesh_numbering(const Selection& selection, const MeshReadInfo& info);
+
+}  // namespace specdeform

@@ -1,0 +1,49 @@
+// The spatial reference solver: the energy of deform_options.h minimised over all n vertices
+// (Rong, Cao & Guo 2008, eq. 14, with a sparse Cholesky factorisation instead of the paper's
+// iterative BiCG), the baseline of the benchmarks and the ground truth of the tests.
+//
+//   A = ks K + kb A_s K D^-1 K      (n x n, D the lumped mass, A_s the surface area)
+//   hard: Dirichlet conditions d_C = t, A_FF d_F = -A_FC t
+//   soft: (A + w W) d = w W t, W = a_i on the constrained vertices
+// factored with CHOLMOD once per selection; each frame is one back-substitution (3 columns).
+// The bi-Laplacian always uses the lumped mass (the consistent one would make it dense).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <Eigen/Sparse>
+
+#include "specdeform/deform/deform_options.h"
+#include "specdeform/mesh/triangle_mesh.h"
+
+namespace specdeform {
+
+class SpatialSolver {
+ public:
+  SpatialSolver(const TriangleMesh& mesh, const DeformOptions& options);
+  ~SpatialSolver();
+  SpatialSolver(SpatialSolver&&) noexcept;
+  SpatialSolver& operator=(SpatialSolver&&) noexcept;
+
+  // Factors the system for these constrained vertices. Throws SolverError if it is singular.
+  void set_constraints(const std::vector<int>& vertices);
+
+  // Displacement of every vertex (n x 3) for target displacements t (n' x 3).
+  Eigen::MatrixX3d solve(const Eigen::MatrixX3d& targets) const;
+
+  // The energy's matrix A (n x n), on the unit-area scale.
+  const Eigen::SparseMatrix<double>& energy_matrix() const { return A_; }
+
+ private:
+  struct Factor;
+  DeformOptions options_;
+  Eigen::SparseMatrix<double> A_;
+  Eigen::VectorXd vertex_area_;  // unit-area scale
+  std::vector<int> constrained_;
+  std::vector<int> free_;                 // hard: the free vertices
+  Eigen::SparseMatrix<double> coupling_;  // hard: A_FC
+  std::unique_ptr<Factor> factor_;
+};
+
+}  // namespace specdeform

@@ -1,0 +1,95 @@
+// Spectral mesh deformation (Rong, Cao & Guo, "Spectral mesh deformation", The Visual Computer
+// 2008): low-pass the mesh to its first m manifold harmonics, deform that smooth base by
+// minimising the energy of deform_options.h in the m-dimensional spectral space under the
+// handle constraints, and add the details back.
+//
+// Built once per mesh and basis; set_selection() once per selection (handles, fixed set);
+// solve() once per frame with one transform per handle group. With DeformSolver::Spatial the
+// base's displacement is computed over all n vertices instead (the reference of eq. 14); the
+// basis then only defines the smooth base, and may be empty, in which case the base is the mesh.
+//
+// Targets: the smooth base's handle vertices follow their group's transform (T s_i) and its
+// fixed vertices stay; the detailed result's handle vertices should reach T x_i and its fixed
+// vertices x_i. Transfer anchors them there exactly; the other methods meet them only as far as
+// the base does (constraint_error() measures it).
+//
+//   SpectralDeformer deformer(mesh, compute_manifold_harmonics(mesh, {.num_modes = 100}));
+//   deformer.set_selection({.handles = {hand}, .fixed = feet});
+//   Vertices frame = deformer.solve({Eigen::Affine3d(Eigen::Translation3d(0, 0.1, 0))});
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "specdeform/deform/deform_options.h"
+#include "specdeform/deform/detail_reconstruction.h"
+#include "specdeform/deform/selection.h"
+#include "specdeform/mesh/triangle_mesh.h"
+#include "specdeform/spectral/manifold_harmonics.h"
+
+namespace specdeform {
+
+class ReducedSolver;
+class SpatialSolver;
+
+// Seconds spent in each stage.
+struct SetupTimings {
+  double reduced_system = 0.0;        // spectral: Hessian and base; spatial: its factorisation
+  double detail_factorization = 0.0;  // Poisson analysis + factorisation (Transfer)
+  double selection = 0.0;             // the whole of the last set_selection()
+};
+
+struct FrameTimings {
+  double reduced_solve = 0.0;      // spectral coefficients (spatial: the back-substitution)
+  double inverse_transform = 0.0;  // d = H c and s' = s + d
+  double detail = 0.0;             // adding the details back
+  double total = 0.0;
+};
+
+// Distances of the constrained vertices to their targets, over the bounding-box diagonal.
+struct ConstraintError {
+  double max = 0.0;
+  double rms = 0.0;
+};
+
+class SpectralDeformer {
+ public:
+  SpectralDeformer(TriangleMesh mesh, ManifoldHarmonics basis, const DeformOptions& options = {});
+  ~SpectralDeformer();
+  SpectralDeformer(SpectralDeformer&&) noexcept;
+  SpectralDeformer& operator=(SpectralDeformer&&) noexcept;
+
+  // Throws InputError for a bad selection (see constrained_set).
+  void set_selection(const Selection& selection);
+
+  // The deformed detailed mesh (n x 3) for one transform per handle group.
+  Vertices solve(const std::vector<Eigen::Affine3d>& transforms);
+
+  // Error of `result` (a solve() output) against the targets of the last solve().
+  ConstraintError constraint_error(const Vertices& result) const;
+
+  const TriangleMesh& mesh() const { return mesh_; }
+  const Vertices& base() const { return base_; }                    // s
+  const Vertices& deformed_base() const { return deformed_base_; }  // s' of the last solve
+  const DeformOptions& options() const { return options_; }
+  const SetupTimings& setup_timings() const { return setup_; }
+  const FrameTimings& frame_timings() const { return frame_; }
+
+ private:
+  TriangleMesh mesh_;
+  ManifoldHarmonics basis_;
+  DeformOptions options_;
+  Eigen::MatrixXf basis32_;  // float32_basis: the basis in single precision
+  Vertices base_, deformed_base_;
+  std::unique_ptr<ReducedSolver> reduced_;
+  std::unique_ptr<SpatialSolver> spatial_;
+  std::unique_ptr<DetailReconstruction> details_;
+  ConstrainedSet constrained_;
+  Eigen::MatrixX3d detail_targets_;  // targets of the last solve, for constraint_error
+  SetupTimings setup_;
+  FrameTimings frame_;
+};
+
+}  // namespace specdeform

@@ -1,0 +1,72 @@
+#include "specdeform/deform/selection.h"
+
+#include <string>
+
+#include "specdeform/exceptions.h"
+#include "specdeform/mesh/mesh_info.h"
+
+namespace specdeform {
+
+ConstrainedSet constrained_set(const Selection& selection, const TriangleMesh& mesh) {
+  const int n = mesh.num_vertices();
+  ConstrainedSet set;
+  set.num_groups = static_cast<int>(selection.handles.size());
+  std::vector<int> owner(n, -2);
+  const auto add = [&](int v, int group) {
+    if (v < 0 || v >= n) {
+      throw InputError("selection: vertex " + std::to_string(v) +
+                       " is out of range (the mesh has " + std::to_string(n) + " vertices)");
+    }
+    if (owner[v] != -2) {
+      if (owner[v] == group) return;  // listed twice in the same group
+      throw InputError("selection: vertex " + std::to_string(v) + " belongs to two groups");
+    }
+    owner[v] = group;
+    set.vertices.push_back(v);
+    set.group.push_back(group);
+  };
+  for (int g = 0; g < set.num_groups; ++g)
+    for (const int v : selection.handles[g]) add(v, g);
+  for (const int v : selection.fixed) add(v, -1);
+  if (set.vertices.empty()) throw InputError("selection: no handle and no fixed vertex");
+  int components = 0;
+  const Eigen::VectorXi label = vertex_components(mesh, &components);
+  std::vector<char> pinned(components, 0);
+  for (const int v : set.vertices) pinned[label[v]] = 1;
+  for (int c = 0; c < components; ++c) {
+    if (!pinned[c]) {
+      throw InputError("selection: connected component " + std::to_string(c) + " of " +
+                       std::to_string(components) +
+                       " has no handle or fixed vertex, so its position is undefined");
+    }
+  }
+  return set;
+}
+
+Eigen::MatrixX3d constraint_targets(const ConstrainedSet& set, const Eigen::MatrixX3d& positions,
+                                    const std::vector<Eigen::Affine3d>& transforms) {
+  if (static_cast<int>(transforms.size()) != set.num_groups) {
+    throw InputError("deformation: " + std::to_string(transforms.size()) + " transforms for " +
+                     std::to_string(set.num_groups) + " handle groups");
+  }
+  for (size_t g = 0; g < transforms.size(); ++g) {
+    const Eigen::Matrix4d& T = transforms[g].matrix();
+    if (!T.allFinite()) {
+      throw InputError("deformation: the transform of handle group " + std::to_string(g) +
+                       " is not finite");
+    }
+    const double det = T.topLeftCorner<3, 3>().determinant();
+    if (!(std::abs(det) > 1e-12 * std::pow(T.topLeftCorner<3, 3>().norm(), 3))) {
+      throw InputError("deformation: the transform of handle group " + std::to_string(g) +
+                       " is singular");
+    }
+  }
+  Eigen::MatrixX3d targets(set.vertices.size(), 3);
+  for (size_t i = 0; i < set.vertices.size(); ++i) {
+    const Eigen::Vector3d p = positions.row(set.vertices[i]);
+    targets.row(i) = set.group[i] < 0 ? p : Eigen::Vector3d(transforms[set.group[i]] * p);
+  }
+  return targets;
+}
+
+}  // namespace specdeform

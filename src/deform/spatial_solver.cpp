@@ -1,0 +1,96 @@
+#include "specdeform/deform/spatial_solver.h"
+
+#include <Eigen/CholmodSupport>
+
+#include "specdeform/exceptions.h"
+#include "specdeform/operators/cotan_laplacian.h"
+#include "specdeform/operators/mass_matrix.h"
+
+namespace specdeform {
+
+struct SpatialSolver::Factor {
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+};
+
+SpatialSolver::SpatialSolver(const TriangleMesh& mesh, const DeformOptions& options)
+    : options_(options), factor_(std::make_unique<Factor>()) {
+  const Eigen::SparseMatrix<double> K = cotan_stiffness(mesh);
+  const Eigen::VectorXd mass = lumped_mass(mesh);
+  const double area = mass.sum();
+  if ((mass.array() <= 0.0).any()) {
+    throw InputError("spatial solver: some vertices have zero area (only degenerate faces)");
+  }
+  vertex_area_ = mass / area;
+  const Eigen::SparseMatrix<double> Dinv_K = mass.cwiseInverse().asDiagonal() * K;
+  A_ = options.ks * K + (options.kb * area) * Eigen::SparseMatrix<double>(K * Dinv_K);
+  A_.makeCompressed();
+}
+
+SpatialSolver::~SpatialSolver() = default;
+SpatialSolver::SpatialSolver(SpatialSolver&&) noexcept = default;
+SpatialSolver& SpatialSolver::operator=(SpatialSolver&&) noexcept = default;
+
+void SpatialSolver::set_constraints(const std::vector<int>& vertices) {
+  const int n = static_cast<int>(A_.rows());
+  constrained_ = vertices;
+  Eigen::SparseMatrix<double> S;
+  if (options_.constraints == ConstraintMode::Soft) {
+    Eigen::VectorXd w = Eigen::VectorXd::Zero(n);
+    for (const int v : vertices) w[v] = options_.constraint_weight * vertex_area_[v];
+    S = A_;
+    S.diagonal() += w;
+  } else {
+    std::vector<int> position(n, -1);
+    for (size_t i = 0; i < vertices.size(); ++i) position[vertices[i]] = -2 - static_cast<int>(i);
+    free_.clear();
+    for (int v = 0; v < n; ++v) {
+      if (position[v] == -1) {
+        position[v] = static_cast<int>(free_.size());
+        free_.push_back(v);
+      }
+    }
+    std::vector<Eigen::Triplet<double>> ff, fc;
+    for (int col = 0; col < n; ++col) {
+      for (Eigen::SparseMatrix<double>::InnerIterator it(A_, col); it; ++it) {
+        const int r = position[it.row()], c = position[col];
+        if (r < 0) continue;
+        if (c >= 0) {
+          ff.emplace_back(r, c, it.value());
+        } else {
+          fc.emplace_back(r, -2 - c, it.value());
+        }
+      }
+    }
+    S.resize(static_cast<int>(free_.size()), static_cast<int>(free_.size()));
+    S.setFromTriplets(ff.begin(), ff.end());
+    coupling_.resize(static_cast<int>(free_.size()), static_cast<int>(vertices.size()));
+    coupling_.setFromTriplets(fc.begin(), fc.end());
+  }
+  factor_->llt.compute(S);
+  if (factor_->llt.info() != Eigen::Success) {
+    throw SolverError("spatial solver: the constrained system is singular");
+  }
+}
+
+Eigen::MatrixX3d SpatialSolver::solve(const Eigen::MatrixX3d& targets) const {
+  const int n = static_cast<int>(A_.rows());
+  if (targets.rows() != static_cast<Eigen::Index>(constrained_.size())) {
+    throw InputError("deformation: targets for " + std::to_string(targets.rows()) +
+                     " vertices, the selection has " + std::to_string(constrained_.size()));
+  }
+  Eigen::MatrixX3d d = Eigen::MatrixX3d::Zero(n, 3);
+  if (options_.constraints == ConstraintMode::Soft) {
+    Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(n, 3);
+    for (size_t i = 0; i < constrained_.size(); ++i) {
+      const int v = constrained_[i];
+      rhs.row(v) = options_.constraint_weight * vertex_area_[v] * targets.row(i);
+    }
+    return factor_->llt.solve(rhs);
+  }
+  const Eigen::MatrixX3d free = factor_->llt.solve(-(coupling_ * targets));
+  for (size_t i = 0; i < free_.size(); ++i) d.row(free_[i]) = free.row(i);
+  for (size_t i = 0; i < constrained_.size(); ++i) d.row(constrained_[i]) = targets.row(i);
+  return d;
+}
+
+}  // namespace specdeform

@@ -1,0 +1,309 @@
+#include "specdeform/deform/spectral_deformer.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/SVD>
+#include <map>
+#include <numbers>
+#include <set>
+
+#include "specdeform/deform/scene.h"
+#include "specdeform/exceptions.h"
+#include "specdeform/mesh/generate.h"
+#include "specdeform/mesh/io.h"
+#include "specdeform/operators/mass_matrix.h"
+#include "support/corpus.h"
+
+namespace specdeform {
+namespace {
+
+ManifoldHarmonics harmonics(const TriangleMesh& mesh, int m) {
+  ManifoldHarmonicsOptions o;
+  o.num_modes = m;
+  return compute_manifold_harmonics(mesh, o);
+}
+
+// A bumpy bar with its left end fixed and its right end as the handle (as in bar-bend).
+struct BarScene {
+  TriangleMesh mesh;
+  Selection selection;
+};
+
+BarScene bar_scene(int cells_per_unit = 10) {
+  BumpyBarOptions o;
+  o.cells_per_unit = cells_per_unit;
+  o.bump_height = 0.05;
+  BarScene s{make_bumpy_bar(o), {}};
+  s.selection.handles.resize(1);
+  for (int i = 0; i < s.mesh.num_vertices(); ++i) {
+    if (s.mesh.V(i, 0) < 0.3) s.selection.fixed.push_back(i);
+    if (s.mesh.V(i, 0) > 3.7) s.selection.handles[0].push_back(i);
+  }
+  return s;
+}
+
+// Rotation by `degrees` about the z axis through `center`.
+Eigen::Affine3d rotation_about(const Eigen::Vector3d& center, double degrees) {
+  return Eigen::Translation3d(center) *
+         Eigen::AngleAxisd(degrees * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()) *
+         Eigen::Translation3d(-center);
+}
+
+const DetailMethod kMethods[] = {DetailMethod::None, DetailMethod::Displacement,
+                                 DetailMethod::Frames, DetailMethod::Transfer};
+
+TEST(SpectralDeformer, IdentityReproducesTheInput) {
+  const BarScene s = bar_scene(6);
+  const double diagonal = bounding_box_diagonal(s.mesh.V);
+  const ManifoldHarmonics h = harmonics(s.mesh, 60);
+  for (const DeformSolver solver : {DeformSolver::Spectral, DeformSolver::Spatial}) {
+    for (const DetailMethod method : kMethods) {
+      DeformOptions o;
+      o.solver = solver;
+      o.detail = method;
+      SpectralDeformer deformer(s.mesh, solver == DeformSolver::Spectral ? h : ManifoldHarmonics{},
+                                o);
+      deformer.set_selection(s.selection);
+      const Vertices out = deformer.solve({Eigen::Affine3d::Identity()});
+      const Vertices& expected = method == DetailMethod::None ? deformer.base() : s.mesh.V;
+      EXPECT_LT((out - expected).cwiseAbs().maxCoeff(), 1e-9 * diagonal)
+          << static_cast<int>(solver) << " " << static_cast<int>(method);
+    }
+  }
+}
+
+// With every eigenvector (m = n) the spectral space is the whole space: the spectral and the
+// spatial minimisers of the same energy under the same constraints coincide.
+TEST(SpectralDeformer, FullBasisEqualsSpatial) {
+  const TriangleMesh mesh = make_bumpy_plane({1.0, 14, 2, 0.05});
+  const int n = mesh.num_vertices();
+  const ManifoldHarmonics h = harmonics(mesh, n);
+  Selection sel;
+  sel.handles = {{n - 1, n - 2, n - 3}};
+  sel.fixed = {0, 1, 2, 15, 16};
+  const Eigen::Affine3d move(Eigen::Translation3d(0.1, -0.2, 0.3));
+  for (const ConstraintMode mode : {ConstraintMode::Hard, ConstraintMode::Soft}) {
+    for (const double ks : {0.0, 1.0}) {
+      DeformOptions o;
+      o.detail = DetailMethod::None;
+      o.constraints = mode;
+      o.ks = ks;
+      SpectralDeformer spectral(mesh, h, o);
+      o.solver = DeformSolver::Spatial;
+      SpectralDeformer spatial(mesh, ManifoldHarmonics{}, o);
+      spectral.set_selection(sel);
+      spatial.set_selection(sel);
+      const Vertices a = spectral.solve({move}), b = spatial.solve({move});
+      EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-8) << static_cast<int>(mode) << " ks " << ks;
+      if (mode == ConstraintMode::Hard) {
+        EXPECT_LT(spectral.constraint_error(a).max, 1e-10);
+      }
+    }
+  }
+}
+
+TEST(SpectralDeformer, OneRigidHandleMovesRigidly) {
+  const BarScene s = bar_scene(6);
+  Selection all;
+  all.handles.resize(1);
+  for (int i = 0; i < s.mesh.num_vertices(); ++i) all.handles[0].push_back(i);
+  const Eigen::Affine3d motion = Eigen::Translation3d(0.5, -1.0, 2.0) *
+                                 Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized());
+  const Vertices expected = (motion * s.mesh.V.transpose()).transpose();
+  DeformOptions o;
+  SpectralDeformer deformer(s.mesh, harmonics(s.mesh, 40), o);
+  deformer.set_selection(all);
+  const Vertices out = deformer.solve({motion});
+  EXPECT_LT((out - expected).cwiseAbs().maxCoeff(), 1e-9 * bounding_box_diagonal(s.mesh.V));
+  EXPECT_LT(deformer.constraint_error(out).max, 1e-12);
+}
+
+// The one-rings of a mesh.
+std::vector<std::set<int>> one_rings(const TriangleMesh& mesh) {
+  std::vector<std::set<int>> ring(mesh.num_vertices());
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) ring[mesh.F(f, k)].insert(mesh.F(f, (k + 1) % 3));
+  return ring;
+}
+
+// Best-fit rotation of vertex i's one-ring from `before` to `after` (Kabsch), and the residual
+// relative to the ring's size: zero for a locally rigid motion.
+std::pair<Eigen::Matrix3d, double> ring_rotation(const std::set<int>& ring, int i,
+                                                 const Vertices& before, const Vertices& after) {
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  double size = 0.0;
+  for (const int j : ring) {
+    const Eigen::Vector3d e = before.row(j) - before.row(i), e2 = after.row(j) - after.row(i);
+    cov += e2 * e.transpose();
+    size += e.squaredNorm();
+  }
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d flip = Eigen::Matrix3d::Identity();
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) flip(2, 2) = -1;
+  const Eigen::Matrix3d R = svd.matrixU() * flip * svd.matrixV().transpose();
+  double residual = 0.0;
+  for (const int j : ring) {
+    const Eigen::Vector3d e = before.row(j) - before.row(i), e2 = after.row(j) - after.row(i);
+    residual += (e2 - R * e).squaredNorm();
+  }
+  return {R, std::sqrt(residual / size)};
+}
+
+struct DetailErrors {
+  double handle_rigidity = 0.0;  // mean one-ring rigidity residual over the handle region
+  double rotation = 0.0;         // sum |delta' - R delta| / sum |delta| (see detail_errors)
+};
+
+// delta_i = x_i - (mean of its one-ring): the local shape (bumps) at i, translation-free.
+Eigen::Vector3d laplacian_coordinate(const std::set<int>& ring, int i, const Vertices& x) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const int j : ring) mean += x.row(j).transpose();
+  return x.row(i).transpose() - mean / static_cast<double>(ring.size());
+}
+
+// rotation: how far the local shape of the result is from the input's local shape turned by
+// the base's local rotation R_i (best fit of the base's one-ring, s -> s').
+DetailErrors detail_errors(const SpectralDeformer& d, const Vertices& result,
+                           const std::vector<int>& handle) {
+  const TriangleMesh& mesh = d.mesh();
+  const auto ring = one_rings(mesh);
+  DetailErrors e;
+  for (const int i : handle) e.handle_rigidity += ring_rotation(ring[i], i, mesh.V, result).second;
+  e.handle_rigidity /= static_cast<double>(handle.size());
+  double size = 0.0;
+  for (int i = 0; i < mesh.num_vertices(); ++i) {
+    const Eigen::Matrix3d R = ring_rotation(ring[i], i, d.base(), d.deformed_base()).first;
+    const Eigen::Vector3d before = laplacian_coordinate(ring[i], i, mesh.V);
+    const Eigen::Vector3d after = laplacian_coordinate(ring[i], i, result);
+    e.rotation += (after - R * before).norm();
+    size += before.norm();
+  }
+  e.rotation /= size;
+  return e;
+}
+
+// Transfer rotates the details with the base; displacement leaves them pointing the old way.
+void expect_transfer_keeps_details(const TriangleMesh& mesh, const Selection& selection,
+                                   const Eigen::Affine3d& bend, const std::string& name) {
+  const ManifoldHarmonics h = harmonics(mesh, 100);
+  std::map<DetailMethod, DetailErrors> errors;
+  for (const DetailMethod method : {DetailMethod::Displacement, DetailMethod::Transfer}) {
+    DeformOptions o;
+    o.detail = method;
+    SpectralDeformer deformer(mesh, h, o);
+    deformer.set_selection(selection);
+    errors[method] = detail_errors(deformer, deformer.solve({bend}), selection.handles[0]);
+  }
+  const DetailErrors& displacement = errors[DetailMethod::Displacement];
+  const DetailErrors& transfer = errors[DetailMethod::Transfer];
+  std::cout << name << ": handle one-ring rigidity error, displacement "
+            << displacement.handle_rigidity << ", transfer " << transfer.handle_rigidity
+            << "; detail rotation error, displacement " << displacement.rotation << ", transfer "
+            << transfer.rotation << "\n";
+  // Where the handle turned the bar, transfer keeps the bumps rigid and displacement does not.
+  // In the bent part both inherit the linear base's own distortion (transfer is still better).
+  EXPECT_LT(transfer.handle_rigidity, 0.5 * displacement.handle_rigidity) << name;
+  EXPECT_LT(transfer.rotation, displacement.rotation) << name;
+}
+
+// When the base turns rigidly, deformation transfer turns the detailed mesh rigidly too, even
+// with a single anchor; displacement does not rotate the details at all.
+TEST(DetailReconstruction, TransferFollowsARigidlyTurnedBase) {
+  const BarScene s = bar_scene(6);
+  const ManifoldHarmonics h = harmonics(s.mesh, 40);
+  SpectralDeformer deformer(s.mesh, h);  // for its smooth base
+  const Eigen::Affine3d motion = Eigen::Translation3d(0.3, 0.2, 0.1) *
+                                 Eigen::AngleAxisd(1.1, Eigen::Vector3d(0, 1, 1).normalized());
+  const Vertices turned_base = (motion * deformer.base().transpose()).transpose();
+  const Vertices expected = (motion * s.mesh.V.transpose()).transpose();
+  DetailReconstruction transfer(s.mesh, deformer.base(), DetailMethod::Transfer);
+  transfer.set_anchors({17});
+  const Vertices out = transfer.apply(turned_base, expected.row(17));
+  EXPECT_LT((out - expected).cwiseAbs().maxCoeff(), 1e-9);
+  DetailReconstruction frames(s.mesh, deformer.base(), DetailMethod::Frames);
+  EXPECT_LT((frames.apply(turned_base, Eigen::MatrixX3d(0, 3)) - expected).cwiseAbs().maxCoeff(),
+            1e-9);
+  DetailReconstruction displacement(s.mesh, deformer.base(), DetailMethod::Displacement);
+  EXPECT_GT(
+      (displacement.apply(turned_base, Eigen::MatrixX3d(0, 3)) - expected).cwiseAbs().maxCoeff(),
+      1e-3);
+}
+
+TEST(SpectralDeformer, TransferKeepsTheBumpsUnderBending) {
+  const BarScene s = bar_scene(10);
+  expect_transfer_keeps_details(
+      s.mesh, s.selection,
+      rotation_about(Eigen::Vector3d(3.7, 0, 0), 90.0) * Eigen::Translation3d(-1.5, 1.0, 0.0),
+      "generated bar");
+  const auto shared = test::shared_dir();
+  if (shared.empty()) GTEST_SKIP() << "../shared is absent: bar-bend scene not available";
+  const auto dir = shared / "meshes" / "scenes";
+  const LoadedMesh bar = read_mesh(dir / "bar-bend.off");
+  const Selection sel = read_sel(dir / "bar-bend.sel", bar.mesh.num_vertices());
+  expect_transfer_keeps_details(bar.mesh, sel, read_def(dir / "bar-bend.def")[0], "bar-bend");
+}
+
+// The spectral displacement converges to the spatial one of the same energy as m grows.
+TEST(SpectralDeformer, ConvergesInTheNumberOfModes) {
+  const BarScene s = bar_scene(6);
+  const Eigen::Affine3d lift(Eigen::Translation3d(0.0, 0.6, 0.2));  // same target for s and x
+  DeformOptions o;
+  o.detail = DetailMethod::None;
+  o.solver = DeformSolver::Spatial;
+  SpectralDeformer spatial(s.mesh, ManifoldHarmonics{}, o);
+  spatial.set_selection(s.selection);
+  const Vertices reference = spatial.solve({lift}) - s.mesh.V;
+  const Eigen::VectorXd mass = lumped_mass(s.mesh);
+  const auto m_norm = [&](const Vertices& d) {
+    return std::sqrt((d.rowwise().squaredNorm().transpose() * mass).value());
+  };
+  o.solver = DeformSolver::Spectral;
+  const ManifoldHarmonics full = harmonics(s.mesh, 320);
+  double previous = std::numeric_limits<double>::infinity(), first = 0.0;
+  for (const int m : {10, 20, 40, 80, 160, 320}) {
+    ManifoldHarmonics h = full;
+    h.basis.conservativeResize(Eigen::NoChange, m);
+    h.eigenvalues.conservativeResize(m);
+    SpectralDeformer spectral(s.mesh, h, o);
+    spectral.set_selection(s.selection);
+    spectral.solve({lift});
+    const double error =
+        m_norm(spectral.deformed_base() - spectral.base() - reference) / m_norm(reference);
+    std::cout << "m = " << m << ": ||d_m - d||_M / ||d||_M = " << error << "\n";
+    EXPECT_LT(error, previous) << m;
+    if (m == 10) first = error;
+    previous = error;
+  }
+  EXPECT_LT(previous, 0.25 * first);
+}
+
+TEST(SpectralDeformer, ClearErrors) {
+  const BarScene s = bar_scene(6);
+  const ManifoldHarmonics h = harmonics(s.mesh, 30);
+  DeformOptions hard;
+  hard.constraints = ConstraintMode::Hard;
+  SpectralDeformer deformer(s.mesh, h, hard);
+  EXPECT_THROW(deformer.set_selection(s.selection), InputError);  // far more than 30 vertices
+  SpectralDeformer soft(s.mesh, h);
+  EXPECT_THROW(soft.solve({Eigen::Affine3d::Identity()}), InputError);  // no selection
+  EXPECT_THROW(soft.set_selection({}), InputError);
+  EXPECT_THROW(soft.set_selection({{{0, 1}}, {1}}), InputError);  // vertex in two groups
+  EXPECT_THROW(soft.set_selection({{{s.mesh.num_vertices()}}, {}}), InputError);
+  soft.set_selection(s.selection);
+  EXPECT_THROW(soft.solve({}), InputError);  // one transform per group
+  Eigen::Affine3d flat = Eigen::Affine3d::Identity();
+  flat.linear()(2, 2) = 0.0;
+  EXPECT_THROW(soft.solve({flat}), InputError);
+  Eigen::Affine3d nan = Eigen::Affine3d::Identity();
+  nan.translation().x() = std::nan("");
+  EXPECT_THROW(soft.solve({nan}), InputError);
+  // A component without constraints cannot be placed.
+  TriangleMesh two = test::concatenate(make_icosphere(1), make_icosphere(1));
+  two.V.bottomRows(42).col(0).array() += 3.0;
+  SpectralDeformer spheres(two, harmonics(two, 10));
+  EXPECT_THROW(spheres.set_selection({{{0}}, {}}), InputError);
+  EXPECT_THROW(SpectralDeformer(s.mesh, ManifoldHarmonics{}), InputError);  // spectral, no basis
+}
+
+}  // namespace
+}  // namespace specdeform
