@@ -42,12 +42,13 @@ Eigen::Matrix3d triangle_frame(const Vertices& V, const Faces& F, int f) {
 }  // namespace
 
 struct DetailReconstruction::Poisson {
-  // Per triangle f: [c - a, b - a, n]^-1 of the base (zero where degenerate), and
-  // Q_f = A_f [grad phi_a; grad phi_b; grad phi_c] [grad x, grad y, grad z] (3 x 3: corners by
-  // coordinates), so that the Poisson right-hand side of the target gradients J_f S_f^T is the
-  // scatter of Q_f S_f^T over the corners.
-  std::vector<Eigen::Matrix3d> inverse;
-  std::vector<Eigen::Matrix3d> corner_gradients;
+  // Per triangle f, with B_f = [c - a, b - a, n] of the base and
+  // Q_f = A_f [grad phi_a; grad phi_b; grad phi_c] [grad x, grad y, grad z] (corners by
+  // coordinates): the Poisson right-hand side of the transferred gradients J_f S_f^T,
+  // S_f = B'_f B_f^-1, is the scatter over the corners of Q_f S_f^T = P_f B'_f^T with
+  // P_f = Q_f B_f^-T. Where the base's triangle is degenerate, S_f = I and P_f holds Q_f.
+  std::vector<Eigen::Matrix3d> transfer;  // P_f (or Q_f)
+  std::vector<char> identity;             // 1 where S_f = I
   Sparse K;         // cotangent stiffness of the detailed mesh
   Sparse anchored;  // K with the anchors' rows and columns made identity
   Sparse coupling;  // n x n': K's columns of the anchors, anchor rows zeroed
@@ -69,17 +70,16 @@ __attribute__((target_clones("avx2", "default"))) void accumulate_divergence(
     const DetailReconstruction::Poisson& p, const Faces& faces, const RowMajor& positions,
     int begin, int end, RowMajor& out) {
   for (int f = begin; f < end; ++f) {
-    const Eigen::Matrix3d& Q = p.corner_gradients[f];
     const int a = faces(f, 0), b = faces(f, 1), c = faces(f, 2);
-    Eigen::Matrix3d C = Q;
-    if (!p.inverse[f].isZero()) {
+    Eigen::Matrix3d C = p.transfer[f];
+    if (!p.identity[f]) {
       Eigen::Matrix3d frame;
       frame.col(0) = (positions.row(c) - positions.row(a)).transpose();
       frame.col(1) = (positions.row(b) - positions.row(a)).transpose();
       const Eigen::Vector3d normal = frame.col(1).cross(frame.col(0));
       const double length = normal.norm();
       frame.col(2) = length > 0.0 ? Eigen::Vector3d(normal / length) : Eigen::Vector3d::Zero();
-      C = Q * (frame * p.inverse[f]).transpose();
+      C = p.transfer[f] * frame.transpose();
     }
     out.row(a) += C.row(0);
     out.row(b) += C.row(1);
@@ -125,20 +125,20 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
       const Sparse G = gradient_operator(detailed);
       const Eigen::VectorXd areas = face_areas(detailed);
       const Eigen::MatrixX3d J = G * detailed.V;  // rows 3f..3f+2: gradients of x, y, z
-      const Sparse Gt = G.transpose();            // column 3f + d: d-components at the corners
       const int nf = detailed.num_faces();
-      p.inverse.resize(nf);
-      p.corner_gradients.resize(nf);
+      p.transfer.resize(nf);
+      p.identity.resize(nf);
       for (int f = 0; f < nf; ++f) {
         const Eigen::Matrix3d m = triangle_frame(base, faces_, f);
         bool invertible = false;
         Eigen::Matrix3d inv;
         m.computeInverseWithCheck(inv, invertible, 1e-300);
-        p.inverse[f] = invertible && m.col(2).squaredNorm() > 0 ? inv : Eigen::Matrix3d::Zero();
         Eigen::Matrix3d corners = Eigen::Matrix3d::Zero();  // rows: corners, columns: x, y, z
         for (int k = 0; k < 3; ++k)
           for (int d = 0; d < 3; ++d) corners(k, d) = G.coeff(3 * f + d, faces_(f, k));
-        p.corner_gradients[f] = areas[f] * corners * J.middleRows<3>(3 * f);
+        const Eigen::Matrix3d Q = areas[f] * corners * J.middleRows<3>(3 * f);
+        p.identity[f] = !(invertible && m.col(2).squaredNorm() > 0);
+        p.transfer[f] = p.identity[f] ? Q : Eigen::Matrix3d(Q * inv.transpose());
       }
       p.K = cotan_stiffness(detailed);
       p.anchored = p.K;

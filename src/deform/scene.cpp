@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <fstream>
+#include <algorithm>
 #include <map>
+#include <numeric>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -163,6 +165,33 @@ std::vector<Eigen::Affine3d> match_transforms(const Selection& selection,
   }
   transforms.resize(selection.handles.size(), Eigen::Affine3d::Identity());
   return transforms;
+}
+
+Selection radius_selection(const TriangleMesh& mesh, int center, double radius,
+                           double fixed_fraction, int up) {
+  const int n = mesh.num_vertices();
+  if (center < 0 || center >= n || up < 0 || up > 2 || !(fixed_fraction >= 0 && fixed_fraction < 1)) {
+    throw InputError("radius selection: bad centre vertex, axis or fraction");
+  }
+  const double r = radius * bounding_box_diagonal(mesh.V);
+  Selection s;
+  s.handles.resize(1);
+  std::vector<char> in_handle(n, 0);
+  for (int i = 0; i < n; ++i) {
+    if ((mesh.V.row(i) - mesh.V.row(center)).norm() <= r) {
+      s.handles[0].push_back(i);
+      in_handle[i] = 1;
+    }
+  }
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  const int count = static_cast<int>(fixed_fraction * n);
+  std::nth_element(order.begin(), order.begin() + count, order.end(),
+                   [&](int a, int b) { return mesh.V(a, up) < mesh.V(b, up); });
+  for (int k = 0; k < count; ++k)
+    if (!in_handle[order[k]]) s.fixed.push_back(order[k]);
+  std::sort(s.fixed.begin(), s.fixed.end());
+  return s;
 }
 
 Selection to_mesh_numbering(const Selection& selection, const MeshReadInfo& info) {

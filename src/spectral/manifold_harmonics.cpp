@@ -397,7 +397,9 @@ Spectrum solve_block_krylov(const Sparse& K, const Sparse& Mmat, int m,
   const int n = static_cast<int>(K.rows());
   const MassOperator M(Mmat);
   std::mt19937_64 rng(o.seed);
-  const int band = o.band_size > 0 ? o.band_size : std::min(m, 160);
+  // Up to 150 pairs in one band; beyond, bands of 90 (measured fastest on the armadillo at
+  // m = 1000: the orthogonalisation grows with the square of the band, a factorisation is cheap).
+  const int band = o.band_size > 0 ? o.band_size : (m <= 150 ? m : 90);
   Spectrum out;
   out.H.resize(n, m);
   out.lambda.resize(m);

@@ -60,6 +60,12 @@ Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertice
 std::vector<Eigen::Affine3d> match_transforms(const Selection& selection,
                                               std::vector<Eigen::Affine3d> transforms);
 
+// A reproducible scene for benchmarks and experiments: one handle group, the vertices within
+// `radius` (a fraction of the bounding-box diagonal) of vertex `center`; fixed, the
+// `fixed_fraction` of all vertices lowest along axis `up` (0 = x, 1 = y, 2 = z), minus handles.
+Selection radius_selection(const TriangleMesh& mesh, int center, double radius,
+                           double fixed_fraction, int up);
+
 // From file vertex indices to the loaded mesh's; vertices the reader dropped are left out.
 Selection to_mesh_numbering(const Selection& selection, const MeshReadInfo& info);
 
