@@ -48,5 +48,6 @@ void add_generate_command(CLI::App& app);
 void add_subdivide_command(CLI::App& app);
 void add_demo_command(CLI::App& app);
 void add_deform_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
 
 }  // namespace specdeform::cli

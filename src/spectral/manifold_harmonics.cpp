@@ -392,6 +392,31 @@ double clear_shift(double target, const std::vector<double>& known) {
   return target;
 }
 
+// K's null space, known exactly: the constants on each connected component of K's graph (the
+// stiffness matrix's energy vanishes only there), M-normalised. n x (number of components).
+Mat stiffness_null_space(const Sparse& K, const Sparse& M) {
+  const int n = static_cast<int>(K.rows());
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto find = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (int col = 0; col < K.outerSize(); ++col)
+    for (Sparse::InnerIterator it(K, col); it; ++it) parent[find(static_cast<int>(it.row()))] = find(col);
+  std::vector<int> label(n, -1);
+  int count = 0;
+  for (int i = 0; i < n; ++i) {
+    int& l = label[find(i)];
+    if (l < 0) l = count++;
+    label[i] = l;
+  }
+  Mat Z = Mat::Zero(n, count);
+  for (int i = 0; i < n; ++i) Z(i, label[i]) = 1.0;
+  const Vec norms = (Z.transpose() * (M * Z)).diagonal().cwiseSqrt();
+  return Z * norms.cwiseInverse().asDiagonal();
+}
+
 Spectrum solve_block_krylov(const Sparse& K, const Sparse& Mmat, int m,
                             const ManifoldHarmonicsOptions& o) {
   const int n = static_cast<int>(K.rows());
@@ -403,7 +428,13 @@ Spectrum solve_block_krylov(const Sparse& K, const Sparse& Mmat, int m,
   Spectrum out;
   out.H.resize(n, m);
   out.lambda.resize(m);
-  int count = 0;
+  // The zero eigenvalues are known: start from them, and keep the Krylov spaces clear of them
+  // (their Ritz values 1/|sigma| would otherwise dwarf the others and magnify round-off).
+  const Mat null_space = stiffness_null_space(K, Mmat);
+  int count = std::min<int>(m, static_cast<int>(null_space.cols()));
+  out.H.leftCols(count) = null_space.leftCols(count);
+  out.lambda.head(count).setZero();
+  if (count == m && null_space.cols() > m) out.cluster_truncated = true;
   double sigma = o.shift;
   double spacing = 4.0 * std::numbers::pi;  // Weyl's law on a closed unit-area surface
   int retries = 0;
@@ -442,16 +473,18 @@ Spectrum solve_block_krylov(const Sparse& K, const Sparse& Mmat, int m,
     std::vector<double> seen(1, count > 0 ? last : sigma);
     seen.insert(seen.end(), r.lambda.begin(), r.lambda.end());
     const Vec residual = pair_residuals(K, Mmat, r.H, r.lambda);
-    if (r.converged && residual.maxCoeff() > 10 * o.tolerance) {
+    if (sigma > 0.0 && r.converged && residual.maxCoeff() > 10 * o.tolerance) {
       // Inaccurate solves broke the Krylov relation (a shift close to an eigenvalue): redo the
       // band with the shift in a gap between the eigenvalues seen.
       retry(clear_shift(sigma, seen));
       continue;
     }
+    if (residual.maxCoeff() > 100 * o.tolerance) r.converged = false;
     double radius = 0.0;
     for (int i = 0; i < r.lambda.size(); ++i)
       radius = std::max(radius, std::abs(r.lambda[i] - sigma));
-    if (count > 0 && r.converged && sigma - radius > last + 1e-9 * std::max(1.0, std::abs(last))) {
+    if (sigma > 0.0 && r.converged &&
+        sigma - radius > last + 1e-9 * std::max(1.0, std::abs(last))) {
       // The band does not reach down to the pairs already found: eigenvalues in between could
       // be missed. Move the shift down and redo the band.
       retry(clear_shift(last + 0.5 * (sigma - last), seen));

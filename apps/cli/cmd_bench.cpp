@@ -1,0 +1,209 @@
+// specdeform bench: the measurements of the paper's Table 1 (and Fig. 5 with --modes-sweep),
+// against the spatial solver of the same energy, from scratch (the paper's last column) and
+// prefactored (one back-substitution per frame, the honest competitor).
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "common.h"
+#include "specdeform/atomic_file.h"
+#include "specdeform/deform/scene.h"
+#include "specdeform/exceptions.h"
+#include "specdeform/deform/spectral_deformer.h"
+#include "specdeform/mesh/generate.h"
+#include "specdeform/mesh/subdivide.h"
+
+namespace specdeform::cli {
+
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+double peak_rss_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;
+}
+
+// The reproducible scene: along the bounding box's longest axis, the handle is every vertex
+// within 5% of the diagonal of the topmost vertex and the lowest 10% of the vertices are fixed;
+// the handle moves by 10% of the diagonal along the second-longest axis.
+struct BenchScene {
+  Selection selection;
+  std::vector<Eigen::Affine3d> transforms;
+};
+
+BenchScene bench_scene(const TriangleMesh& mesh) {
+  const Eigen::Vector3d extent = mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff();
+  int axes[3] = {0, 1, 2};
+  std::sort(axes, axes + 3, [&](int a, int b) { return extent[a] > extent[b]; });
+  Eigen::Index top;
+  mesh.V.col(axes[0]).maxCoeff(&top);
+  BenchScene s;
+  s.selection = radius_selection(mesh, static_cast<int>(top), 0.05, 0.10, axes[0]);
+  Eigen::Vector3d move = Eigen::Vector3d::Zero();
+  move[axes[1]] = 0.1 * extent.norm();
+  s.transforms = {Eigen::Affine3d(Eigen::Translation3d(move))};
+  return s;
+}
+
+struct FrameStats {
+  double reduced = 0, inverse = 0, detail = 0, total = 0;
+};
+
+FrameStats time_frames(SpectralDeformer& d, const BenchScene& s, int repeat) {
+  std::vector<double> reduced, inverse, detail, total;
+  for (int r = 0; r < repeat; ++r) {
+    d.solve(s.transforms);
+    const FrameTimings& t = d.frame_timings();
+    reduced.push_back(t.reduced_solve);
+    inverse.push_back(t.inverse_transform);
+    detail.push_back(t.detail);
+    total.push_back(t.total);
+  }
+  return {median(reduced), median(inverse), median(detail), median(total)};
+}
+
+nlohmann::ordered_json bench_mesh(const std::string& name, const TriangleMesh& mesh, int modes,
+                                  int repeat, const ManifoldHarmonicsOptions& harmonics) {
+  const BenchScene scene = bench_scene(mesh);
+  nlohmann::ordered_json j;
+  j["mesh"] = name;
+  j["vertices"] = mesh.num_vertices();
+  j["faces"] = mesh.num_faces();
+  j["modes"] = modes;
+  j["handle_vertices"] = scene.selection.handles[0].size();
+  j["fixed_vertices"] = scene.selection.fixed.size();
+
+  ManifoldHarmonicsOptions o = harmonics;
+  o.num_modes = modes;
+  Stopwatch clock;
+  ManifoldHarmonics basis = compute_manifold_harmonics(mesh, o);
+  j["PT1_basis"] = clock.seconds();
+  if (basis.status != SolveStatus::Converged) throw SolverError(name + ": basis did not converge");
+
+  clock = Stopwatch();
+  SpectralDeformer d(mesh, std::move(basis));
+  d.set_selection(scene.selection);
+  const SetupTimings& setup = d.setup_timings();
+  j["PT2_reduced_system"] = setup.reduced_system + (setup.selection - setup.detail_factorization);
+  j["PT3_detail_factorization"] = setup.detail_factorization;
+  const FrameStats f = time_frames(d, scene, repeat);
+  j["RT1_reduced_solve"] = f.reduced;
+  j["inverse_transform"] = f.inverse;
+  j["RT2_detail"] = f.detail;
+  j["frame"] = f.total;
+  j["constraint_error_max"] = d.constraint_error(d.solve(scene.transforms)).max;
+
+  // The spatial solve of the same energy on the detailed mesh (eq. 14): from scratch (its
+  // factorisation included, as the paper's last column) and prefactored.
+  DeformOptions spatial;
+  spatial.solver = DeformSolver::Spatial;
+  spatial.detail = DetailMethod::None;
+  spatial.constraints = ConstraintMode::Hard;
+  clock = Stopwatch();
+  SpectralDeformer reference(mesh, ManifoldHarmonics{}, spatial);
+  reference.set_selection(scene.selection);
+  reference.solve(scene.transforms);
+  j["spatial_from_scratch"] = clock.seconds();
+  j["spatial_prefactored_frame"] = time_frames(reference, scene, repeat).total;
+  j["peak_rss_MB"] = peak_rss_mb();
+  return j;
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+std::string markdown(const nlohmann::ordered_json& rows) {
+  std::string s =
+      "| mesh | vertices | m | PT1 basis (s) | PT2 reduced (ms) | PT3 detail factor (ms) | "
+      "RT1 reduced solve (ms) | inverse transform (ms) | RT2 detail (ms) | frame (ms) | "
+      "spatial prefactored frame (ms) | spatial from scratch (s) | peak RSS (MB) |\n"
+      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const auto& r : rows) {
+    s += "| " + r["mesh"].get<std::string>() + " | " + std::to_string(r["vertices"].get<int>()) +
+         " | " + std::to_string(r["modes"].get<int>()) + " | " +
+         fixed(r["PT1_basis"].get<double>(), 2) + " | " +
+         fixed(1e3 * r["PT2_reduced_system"].get<double>(), 1) + " | " +
+         fixed(1e3 * r["PT3_detail_factorization"].get<double>(), 1) + " | " +
+         fixed(1e3 * r["RT1_reduced_solve"].get<double>(), 2) + " | " +
+         fixed(1e3 * r["inverse_transform"].get<double>(), 2) + " | " +
+         fixed(1e3 * r["RT2_detail"].get<double>(), 2) + " | " +
+         fixed(1e3 * r["frame"].get<double>(), 2) + " | " +
+         fixed(1e3 * r["spatial_prefactored_frame"].get<double>(), 2) + " | " +
+         fixed(r["spatial_from_scratch"].get<double>(), 3) + " | " +
+         fixed(r["peak_rss_MB"].get<double>(), 0) + " |\n";
+  }
+  return s;
+}
+
+}  // namespace
+
+void add_bench_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "bench", "measure the paper's Table 1 on meshes, against the spatial solver, in one run");
+  struct Args {
+    std::vector<std::string> meshes;
+    std::vector<int> subdivide{0};
+    int modes = 100, repeat = 21;
+    bool quick = false;
+    std::string json, markdown;
+    ManifoldHarmonicsOptions harmonics;
+  };
+  auto args = std::make_shared<Args>();
+  cmd->add_option("MESHES", args->meshes, "meshes to measure (default: generated bumpy bars)");
+  cmd->add_option("--subdivide", args->subdivide,
+                  "also measure each mesh Loop-subdivided this many times (e.g. 0 1 2)")
+      ->check(CLI::Range(0, 3));
+  cmd->add_option("-m,--modes", args->modes, "manifold harmonics (default 100)")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option("--repeat", args->repeat, "frames per median (default 21)")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_flag("--quick", args->quick, "small generated meshes, a few seconds (for tests)");
+  cmd->add_option("--json", args->json, "write the rows as JSON to this file");
+  cmd->add_option("--markdown", args->markdown, "write a markdown table to this file");
+  add_harmonics_options(*cmd, args->harmonics);
+  cmd->callback([args] {
+    std::vector<std::pair<std::string, TriangleMesh>> meshes;
+    for (const std::string& path : args->meshes) {
+      meshes.emplace_back(std::filesystem::path(path).stem().string(), load_mesh(path).mesh);
+    }
+    if (meshes.empty()) {
+      for (const int cells : args->quick ? std::vector<int>{6, 10} : std::vector<int>{16, 32, 49}) {
+        BumpyBarOptions o;
+        o.cells_per_unit = cells;
+        meshes.emplace_back("bumpy-bar-" + std::to_string(cells), make_bumpy_bar(o));
+      }
+    }
+    const int modes = args->quick ? std::min(args->modes, 40) : args->modes;
+    const int repeat = args->quick ? std::min(args->repeat, 3) : args->repeat;
+    nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+    for (const auto& [name, mesh] : meshes) {
+      for (const int levels : args->subdivide) {
+        const std::string label = levels == 0 ? name : name + " (subdivided " + std::to_string(levels) + "x)";
+        std::cerr << "bench: " << label << "\n";
+        rows.push_back(bench_mesh(label, levels == 0 ? mesh : subdivide(mesh, levels), modes,
+                                  repeat, args->harmonics));
+      }
+    }
+    const std::string table = markdown(rows);
+    if (!args->json.empty()) write_file_atomically(args->json, rows.dump(2) + "\n");
+    if (!args->markdown.empty()) write_file_atomically(args->markdown, table);
+    std::cout << table;
+  });
+}
+
+}  // namespace specdeform::cli
