@@ -70,7 +70,8 @@ SpectralDeformer make(const Setup& s, DeformSolver solver, bool float32 = false)
 
 void report(benchmark::State& state, const Setup& s, const SpectralDeformer& d) {
   state.counters["n"] = s.mesh.num_vertices();
-  state.counters["constrained"] = static_cast<double>(s.selection.handles[0].size() + s.selection.fixed.size());
+  state.counters["constrained"] =
+      static_cast<double>(s.selection.handles[0].size() + s.selection.fixed.size());
   state.counters["reduced_ms"] = d.frame_timings().reduced_solve * 1e3;
   state.counters["inverse_ms"] = d.frame_timings().inverse_transform * 1e3;
   state.counters["detail_ms"] = d.frame_timings().detail * 1e3;
@@ -96,15 +97,33 @@ void BM_SelectionChange(benchmark::State& state, DeformSolver solver) {
 }
 
 BENCHMARK_CAPTURE(BM_Frame, spectral, DeformSolver::Spectral, false)
-    ->ArgName("subdiv")->Arg(0)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->ArgName("subdiv")
+    ->Arg(0)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Frame, spectral_float32, DeformSolver::Spectral, true)
-    ->ArgName("subdiv")->Arg(0)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->ArgName("subdiv")
+    ->Arg(0)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Frame, spatial_prefactored, DeformSolver::Spatial, false)
-    ->ArgName("subdiv")->Arg(0)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->ArgName("subdiv")
+    ->Arg(0)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_SelectionChange, spectral, DeformSolver::Spectral)
-    ->ArgName("subdiv")->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->ArgName("subdiv")
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_SelectionChange, spatial_prefactored, DeformSolver::Spatial)
-    ->ArgName("subdiv")->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->ArgName("subdiv")
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 

@@ -15,8 +15,8 @@
 #include "common.h"
 #include "specdeform/atomic_file.h"
 #include "specdeform/deform/scene.h"
-#include "specdeform/exceptions.h"
 #include "specdeform/deform/spectral_deformer.h"
+#include "specdeform/exceptions.h"
 #include "specdeform/mesh/generate.h"
 #include "specdeform/mesh/subdivide.h"
 
@@ -193,7 +193,8 @@ void add_bench_command(CLI::App& app) {
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
     for (const auto& [name, mesh] : meshes) {
       for (const int levels : args->subdivide) {
-        const std::string label = levels == 0 ? name : name + " (subdivided " + std::to_string(levels) + "x)";
+        const std::string label =
+            levels == 0 ? name : name + " (subdivided " + std::to_string(levels) + "x)";
         std::cerr << "bench: " << label << "\n";
         rows.push_back(bench_mesh(label, levels == 0 ? mesh : subdivide(mesh, levels), modes,
                                   repeat, args->harmonics));

@@ -1,8 +1,8 @@
 #include "specdeform/deform/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <algorithm>
 #include <map>
 #include <numeric>
 #include <sstream>
@@ -170,7 +170,8 @@ std::vector<Eigen::Affine3d> match_transforms(const Selection& selection,
 Selection radius_selection(const TriangleMesh& mesh, int center, double radius,
                            double fixed_fraction, int up) {
   const int n = mesh.num_vertices();
-  if (center < 0 || center >= n || up < 0 || up > 2 || !(fixed_fraction >= 0 && fixed_fraction < 1)) {
+  if (center < 0 || center >= n || up < 0 || up > 2 ||
+      !(fixed_fraction >= 0 && fixed_fraction < 1)) {
     throw InputError("radius selection: bad centre vertex, axis or fraction");
   }
   const double r = radius * bounding_box_diagonal(mesh.V);

@@ -403,7 +403,8 @@ Mat stiffness_null_space(const Sparse& K, const Sparse& M) {
     return i;
   };
   for (int col = 0; col < K.outerSize(); ++col)
-    for (Sparse::InnerIterator it(K, col); it; ++it) parent[find(static_cast<int>(it.row()))] = find(col);
+    for (Sparse::InnerIterator it(K, col); it; ++it)
+      parent[find(static_cast<int>(it.row()))] = find(col);
   std::vector<int> label(n, -1);
   int count = 0;
   for (int i = 0; i < n; ++i) {

@@ -50,6 +50,10 @@ expect 1 "$bin" deform "$tmp/p.off" --sel "$tmp/short.sel" --def "$tmp/p.def" -o
 printf '{"handles": [{"vertices": [9999]}]}' >"$tmp/bad.json"
 expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/bad.json" -o "$tmp/x.off"
 expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/scene.json" --constraints hard -m 3 -o "$tmp/x.off"
+expect 0 "$bin" bench --quick --json "$tmp/bench.json" --markdown "$tmp/bench.md"
+grep -q '"PT1_basis"' "$tmp/bench.json" && grep -q '"spatial_prefactored_frame"' "$tmp/bench.json" ||
+  { echo "FAIL: bench JSON lacks the Table 1 columns"; fails=$((fails + 1)); }
+grep -q '^| bumpy-bar-6 ' "$tmp/bench.md" || { echo "FAIL: bench markdown lacks its rows"; fails=$((fails + 1)); }
 expect 0 "$bin" demo -o "$tmp/demo" -m 40
 [ -s "$tmp/demo/4_deformed.obj" ] || { echo "FAIL: demo wrote no deformed mesh"; fails=$((fails + 1)); }
 [ "$fails" = 0 ] && echo "cli tests passed"
