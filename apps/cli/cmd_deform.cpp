@@ -24,7 +24,8 @@ double median(std::vector<double> v) {
 void add_deform_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("deform", "deform a mesh by handles: spectral or spatial solve");
   struct Args {
-    std::string mesh, output, sel, def, dmat, scene, basis;
+    std::string mesh, output, basis;
+    SceneArgs scene;
     int modes = 100, repeat = 1;
     bool json = false;
     DeformOptions options;
@@ -42,16 +43,7 @@ void add_deform_command(CLI::App& app) {
                                                                   {"hard", ConstraintMode::Hard}};
   cmd->add_option("MESH", args->mesh, "mesh file (optional with a --scene that names one)");
   cmd->add_option("-o,--output", args->output, "deformed mesh to write")->required();
-  auto* sel =
-      cmd->add_option("--sel", args->sel, "Botsch-Sorkine selection (0 fixed, 1 free, 2 handle)");
-  auto* dmat =
-      cmd->add_option("--dmat", args->dmat, "libigl selection (-1 free, k handle group k)");
-  auto* def =
-      cmd->add_option("--def", args->def, "handle transforms: 4x4 row-major, one per group");
-  auto* scene = cmd->add_option("--scene", args->scene, "JSON scene (see docs/scene.md)");
-  sel->excludes(dmat)->excludes(scene)->needs(def);
-  dmat->excludes(scene)->needs(def);
-  def->excludes(scene);
+  args->scene.add_to(*cmd);
   cmd->add_option("-m,--modes", args->modes, "manifold harmonics used (default 100)")
       ->check(CLI::Range(1, 1000000));
   cmd->add_option("--ks", args->options.ks, "stretching weight (default 0)")->check(kNonNegative);
@@ -74,30 +66,14 @@ void add_deform_command(CLI::App& app) {
   cmd->add_flag("--json", args->json, "print one JSON object with timings and errors");
   add_harmonics_options(*cmd, args->harmonics);
   cmd->callback([args, cmd] {
-    if (args->sel.empty() && args->dmat.empty() && args->scene.empty()) {
-      throw CLI::ValidationError("deform", "give --sel and --def, --dmat and --def, or --scene");
-    }
     // The scene's settings override the defaults; options given on the command line win.
+    const LoadedScene loaded_scene = load_scene(args->mesh, args->scene, args->options);
+    const LoadedMesh& loaded = loaded_scene.mesh;
+    const Scene& scene = loaded_scene.scene;
+    const Selection& selection = loaded_scene.selection;
     DeformOptions options = args->options;
     int modes = args->modes;
-    Scene scene;
-    std::string mesh_path = args->mesh;
-    LoadedMesh loaded;
-    if (!args->scene.empty()) {
-      if (mesh_path.empty()) {
-        // The mesh is named by the scene: read the scene once for the name, then again with
-        // the mesh's positions (for centroid centres).
-        scene = read_scene(args->scene, Vertices(0, 3));
-        if (scene.mesh.empty())
-          throw InputError(args->scene + ": the scene names no mesh; give MESH");
-        mesh_path = scene.mesh.string();
-      }
-    } else if (mesh_path.empty()) {
-      throw CLI::ValidationError("deform", "MESH is required");
-    }
-    loaded = load_mesh(mesh_path);
-    if (!args->scene.empty()) {
-      scene = read_scene(args->scene, loaded.info.file_vertices, options);
+    if (!args->scene.scene.empty()) {
       const auto keep = [&](const char* flag, auto& field, const auto& from_scene) {
         if (cmd->count(flag) == 0) field = from_scene;
       };
@@ -108,13 +84,7 @@ void add_deform_command(CLI::App& app) {
       keep("--solver", options.solver, scene.options.solver);
       keep("--constraints", options.constraints, scene.options.constraints);
       if (cmd->count("--modes") == 0 && scene.modes) modes = *scene.modes;
-    } else {
-      const int nf = static_cast<int>(loaded.info.file_vertices.rows());
-      scene.selection = args->sel.empty() ? read_dmat(args->dmat, nf) : read_sel(args->sel, nf);
-      scene.transforms = read_def(args->def);
     }
-    scene.transforms = match_transforms(scene.selection, scene.transforms);
-    const Selection selection = to_mesh_numbering(scene.selection, loaded.info);
 
     nlohmann::ordered_json timings;
     ManifoldHarmonics basis;

@@ -83,6 +83,46 @@ void add_harmonics_options(CLI::App& cmd, ManifoldHarmonicsOptions& o) {
       ->check(kNonNegative);
 }
 
+void SceneArgs::add_to(CLI::App& cmd) {
+  auto* sel_opt =
+      cmd.add_option("--sel", sel, "Botsch-Sorkine selection (0 fixed, 1 free, 2 handle)");
+  auto* dmat_opt = cmd.add_option("--dmat", dmat, "libigl selection (-1 free, k handle group k)");
+  auto* def_opt = cmd.add_option("--def", def, "handle transforms: 4x4 row-major, one per group");
+  auto* scene_opt = cmd.add_option("--scene", scene, "JSON scene (see docs/scene.md)");
+  sel_opt->excludes(dmat_opt)->excludes(scene_opt)->needs(def_opt);
+  dmat_opt->excludes(scene_opt)->needs(def_opt);
+  def_opt->excludes(scene_opt);
+}
+
+LoadedScene load_scene(const std::string& mesh_path, const SceneArgs& args,
+                       const DeformOptions& defaults) {
+  if (args.sel.empty() && args.dmat.empty() && args.scene.empty()) {
+    throw CLI::ValidationError("scene", "give --sel and --def, --dmat and --def, or --scene");
+  }
+  std::string path = mesh_path;
+  if (path.empty()) {
+    if (args.scene.empty()) throw CLI::ValidationError("MESH", "MESH is required");
+    // The mesh is named by the scene: read it once for the name, then again with the mesh's
+    // positions (for centroid centres).
+    const Scene named = read_scene(args.scene, Vertices(0, 3));
+    if (named.mesh.empty()) throw InputError(args.scene + ": the scene names no mesh; give MESH");
+    path = named.mesh.string();
+  }
+  LoadedScene out{load_mesh(path), {}, {}};
+  const int file_vertices = static_cast<int>(out.mesh.info.file_vertices.rows());
+  if (!args.scene.empty()) {
+    out.scene = read_scene(args.scene, out.mesh.info.file_vertices, defaults);
+  } else {
+    out.scene.options = defaults;
+    out.scene.selection =
+        args.sel.empty() ? read_dmat(args.dmat, file_vertices) : read_sel(args.sel, file_vertices);
+    out.scene.transforms = read_def(args.def);
+  }
+  out.scene.transforms = match_transforms(out.scene.selection, out.scene.transforms);
+  out.selection = to_mesh_numbering(out.scene.selection, out.mesh.info);
+  return out;
+}
+
 ManifoldHarmonics obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonicsOptions& options,
                                const std::string& cache, bool* loaded) {
   if (loaded != nullptr) *loaded = false;

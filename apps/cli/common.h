@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "specdeform/deform/scene.h"
 #include "specdeform/mesh/io.h"
 #include "specdeform/spectral/manifold_harmonics.h"
 
@@ -31,6 +32,22 @@ void add_harmonics_options(CLI::App& cmd, ManifoldHarmonicsOptions& options);
 ManifoldHarmonics obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonicsOptions& options,
                                const std::string& cache, bool* loaded = nullptr);
 
+// The handle options shared by deform and converge: --sel/--dmat with --def, or --scene.
+struct SceneArgs {
+  std::string sel, def, dmat, scene;
+  void add_to(CLI::App& cmd);
+};
+
+// A mesh and its scene, read as the options say; the selection in the mesh's numbering, one
+// transform per handle group. `mesh_path` may be empty when the scene names the mesh.
+struct LoadedScene {
+  LoadedMesh mesh;
+  Scene scene;
+  Selection selection;
+};
+LoadedScene load_scene(const std::string& mesh_path, const SceneArgs& args,
+                       const DeformOptions& defaults);
+
 class Stopwatch {
  public:
   double seconds() const {
@@ -49,5 +66,6 @@ void add_subdivide_command(CLI::App& app);
 void add_demo_command(CLI::App& app);
 void add_deform_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_converge_command(CLI::App& app);
 
 }  // namespace specdeform::cli

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   specdeform::cli::add_subdivide_command(app);
   specdeform::cli::add_deform_command(app);
   specdeform::cli::add_bench_command(app);
+  specdeform::cli::add_converge_command(app);
   specdeform::cli::add_demo_command(app);
   try {
     app.parse(argc, argv);

@@ -54,6 +54,9 @@ expect 0 "$bin" bench --quick --json "$tmp/bench.json" --markdown "$tmp/bench.md
 grep -q '"PT1_basis"' "$tmp/bench.json" && grep -q '"spatial_prefactored_frame"' "$tmp/bench.json" ||
   { echo "FAIL: bench JSON lacks the Table 1 columns"; fails=$((fails + 1)); }
 grep -q '^| bumpy-bar-6 ' "$tmp/bench.md" || { echo "FAIL: bench markdown lacks its rows"; fails=$((fails + 1)); }
+expect 0 "$bin" converge "$tmp/p.off" --scene "$tmp/scene.json" -m 10 20 40 --json "$tmp/conv.json" -o "$tmp/conv"
+grep -q '"displacement_vs_spatial"' "$tmp/conv.json" && [ -s "$tmp/conv/m40_deformed.obj" ] ||
+  { echo "FAIL: converge wrote no table or meshes"; fails=$((fails + 1)); }
 expect 0 "$bin" demo -o "$tmp/demo" -m 40
 [ -s "$tmp/demo/4_deformed.obj" ] || { echo "FAIL: demo wrote no deformed mesh"; fails=$((fails + 1)); }
 [ "$fails" = 0 ] && echo "cli tests passed"

@@ -1,0 +1,134 @@
+// specdeform converge: the paper's Fig. 6 experiment. One scene deformed with m = m_1 < ... < m_k
+// frequencies (one basis of m_k pairs, truncated), each result's distance to the m_k result, and
+// each smooth displacement's distance to the spatial solution of the same energy.
+#include <algorithm>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "common.h"
+#include "specdeform/atomic_file.h"
+#include "specdeform/deform/spectral_deformer.h"
+#include "specdeform/operators/mass_matrix.h"
+
+namespace specdeform::cli {
+
+namespace {
+
+// RMS and maximum of the per-vertex distances between two positions of one mesh, over `scale`.
+// The maximum is over corresponding vertices: an upper bound of the Hausdorff distance.
+std::pair<double, double> distances(const Vertices& a, const Vertices& b, double scale) {
+  const Eigen::VectorXd d = (a - b).rowwise().norm();
+  return {std::sqrt(d.squaredNorm() / d.size()) / scale, d.maxCoeff() / scale};
+}
+
+std::string number(double v) {
+  std::ostringstream s;
+  s << std::setprecision(3) << v;
+  return s.str();
+}
+
+}  // namespace
+
+void add_converge_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "converge", "deform one scene with several m and compare (the paper's Fig. 6)");
+  struct Args {
+    std::string mesh, output, json, markdown;
+    SceneArgs scene;
+    std::vector<int> modes{50, 100, 200, 300, 500, 900};
+    DeformOptions options;
+    ManifoldHarmonicsOptions harmonics;
+  };
+  auto args = std::make_shared<Args>();
+  cmd->add_option("MESH", args->mesh, "mesh file (optional with a --scene that names one)");
+  args->scene.add_to(*cmd);
+  cmd->add_option("-m,--modes", args->modes, "frequencies to compare (default 50 ... 900)")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option("-o,--output", args->output, "folder for the deformed meshes (optional)");
+  cmd->add_option("--json", args->json, "write the rows as JSON to this file");
+  cmd->add_option("--markdown", args->markdown, "write a markdown table to this file");
+  add_harmonics_options(*cmd, args->harmonics);
+  cmd->callback([args] {
+    const LoadedScene s = load_scene(args->mesh, args->scene, args->options);
+    const TriangleMesh& mesh = s.mesh.mesh;
+    std::vector<int> modes = args->modes;
+    std::sort(modes.begin(), modes.end());
+    modes.erase(std::unique(modes.begin(), modes.end()), modes.end());
+    ManifoldHarmonicsOptions h = args->harmonics;
+    h.num_modes = modes.back();
+    const ManifoldHarmonics full = obtain_basis(mesh, h, "");
+    const double diagonal = bounding_box_diagonal(mesh.V);
+
+    // The spatial solution of the same energy and constraints (the smooth displacement's limit).
+    DeformOptions spatial = s.scene.options;
+    spatial.solver = DeformSolver::Spatial;
+    spatial.detail = DetailMethod::None;
+    SpectralDeformer reference(mesh, ManifoldHarmonics{}, spatial);
+    reference.set_selection(s.selection);
+    const Vertices spatial_displacement = reference.solve(s.scene.transforms) - mesh.V;
+    const Eigen::VectorXd mass = lumped_mass(mesh);
+    const auto m_norm = [&](const Vertices& d) {
+      return std::sqrt((d.rowwise().squaredNorm().transpose() * mass).value());
+    };
+
+    std::vector<Vertices> results, bases;
+    for (const int m : modes) {
+      ManifoldHarmonics truncated = full;
+      truncated.basis.conservativeResize(Eigen::NoChange, m);
+      truncated.eigenvalues.conservativeResize(m);
+      SpectralDeformer d(mesh, std::move(truncated), s.scene.options);
+      d.set_selection(s.selection);
+      results.push_back(d.solve(s.scene.transforms));
+      bases.push_back(d.deformed_base());
+      if (!args->output.empty()) {
+        const std::filesystem::path dir = args->output;
+        std::filesystem::create_directories(dir);
+        const std::string tag = "m" + std::to_string(m);
+        write_mesh(dir / (tag + "_smooth_deformed.obj"),
+                   to_file_order(s.mesh.info, d.deformed_base(), mesh.F));
+        write_mesh(dir / (tag + "_deformed.obj"),
+                   to_file_order(s.mesh.info, results.back(), mesh.F));
+        if (m == modes.front()) {
+          write_mesh(dir / "spatial_deformed.obj",
+                     to_file_order(s.mesh.info, mesh.V + spatial_displacement, mesh.F));
+        }
+      }
+      // The smooth displacement d_m = s'_m - s_m against the spatial one.
+      const Vertices displacement = d.deformed_base() - d.base();
+      const double error =
+          m_norm(displacement - spatial_displacement) / m_norm(spatial_displacement);
+      std::cerr << "converge: m = " << m << ", ||d_m - d_spatial||_M / ||d_spatial||_M = " << error
+                << "\n";
+      bases.back() = displacement;
+    }
+    nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+    std::string table = "| m | result vs m = " + std::to_string(modes.back()) +
+                        ": RMS | max | smooth base vs m = " + std::to_string(modes.back()) +
+                        ": RMS | max | smooth displacement vs spatial (M-norm) |\n"
+                        "|---:|---:|---:|---:|---:|---:|\n";
+    for (size_t i = 0; i < modes.size(); ++i) {
+      const auto [rms, max] = distances(results[i], results.back(), diagonal);
+      const auto [base_rms, base_max] = distances(bases[i], bases.back(), diagonal);
+      const double spatial_error =
+          m_norm(bases[i] - spatial_displacement) / m_norm(spatial_displacement);
+      rows.push_back({{"modes", modes[i]},
+                      {"rms", rms},
+                      {"max", max},
+                      {"base_rms", base_rms},
+                      {"base_max", base_max},
+                      {"displacement_vs_spatial", spatial_error}});
+      table += "| " + std::to_string(modes[i]) + " | " + number(rms) + " | " + number(max) + " | " +
+               number(base_rms) + " | " + number(base_max) + " | " + number(spatial_error) + " |\n";
+    }
+    if (!args->json.empty()) write_file_atomically(args->json, rows.dump(2) + "\n");
+    if (!args->markdown.empty()) write_file_atomically(args->markdown, table);
+    std::cout << table;
+  });
+}
+
+}  // namespace specdeform::cli
