@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
+#include "anchored_poisson.h"
 #include "parallel.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/operators/cotan_laplacian.h"
@@ -50,13 +51,9 @@ struct DetailReconstruction::Poisson {
   std::vector<Eigen::Matrix3d> transfer;  // P_f (or Q_f)
   std::vector<char> identity;             // 1 where S_f = I
   Sparse K;                               // cotangent stiffness of the detailed mesh
-  Sparse anchored;                        // K with the anchors' rows and columns made identity
   Sparse coupling;                        // n x n': K's columns of the anchors, anchor rows zeroed
   std::vector<int> anchors;
-  // Simplicial LL^T up to kSupernodalFrom vertices (measured on the armadillo, 43k: it factors
-  // and solves 3 columns faster, with no BLAS threads), supernodal beyond (at 692k vertices it
-  // factors 4x faster and solves as fast). CHOLMOD's own switch picks supernodal at 43k.
-  Eigen::CholmodDecomposition<Sparse, Eigen::Lower> llt;
+  std::unique_ptr<detail::AnchoredPoisson> system;
 };
 
 namespace {
@@ -142,11 +139,7 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
         p.transfer[f] = p.identity[f] ? Q : Eigen::Matrix3d(Q * inv.transpose());
       }
       p.K = cotan_stiffness(detailed);
-      p.anchored = p.K;
-      constexpr int kSupernodalFrom = 200000;
-      p.llt.setMode(detailed.num_vertices() < kSupernodalFrom ? Eigen::CholmodSimplicialLLt
-                                                              : Eigen::CholmodSupernodalLLt);
-      p.llt.analyzePattern(p.K);
+      p.system = std::make_unique<detail::AnchoredPoisson>(p.K);
       break;
     }
   }
@@ -160,19 +153,9 @@ void DetailReconstruction::set_anchors(const std::vector<int>& vertices) {
   if (method_ != DetailMethod::Transfer) return;
   Poisson& p = *poisson_;
   p.anchors = vertices;
-  // Same sparsity pattern as K (explicit zeros kept), so the symbolic analysis is reused.
   std::vector<char> anchored(p.K.rows(), 0);
   for (const int v : vertices) anchored[v] = 1;
-  std::copy(p.K.valuePtr(), p.K.valuePtr() + p.K.nonZeros(), p.anchored.valuePtr());
-  for (int col = 0; col < p.anchored.outerSize(); ++col) {
-    for (Sparse::InnerIterator it(p.anchored, col); it; ++it) {
-      if (anchored[col] || anchored[it.row()]) it.valueRef() = it.row() == col ? 1.0 : 0.0;
-    }
-  }
-  p.llt.factorize(p.anchored);
-  if (p.llt.info() != Eigen::Success) {
-    throw SolverError("deformation transfer: the Poisson system is singular");
-  }
+  p.system->set_anchors(vertices);
   std::vector<Eigen::Triplet<double>> coupling;
   for (size_t i = 0; i < vertices.size(); ++i) {
     for (Sparse::InnerIterator it(p.K, vertices[i]); it; ++it) {
@@ -219,7 +202,7 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
   Eigen::MatrixX3d rhs = halves[0] + halves[1];
   rhs -= p.coupling * anchors;
   for (size_t i = 0; i < p.anchors.size(); ++i) rhs.row(p.anchors[i]) = anchors.row(i);
-  return p.llt.solve(rhs);
+  return p.system->solve(rhs);
 }
 
 }  // namespace specdeform

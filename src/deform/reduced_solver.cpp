@@ -26,9 +26,34 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
     Eigen::VectorXd w(nc);
     for (int i = 0; i < nc; ++i) w[i] = options_.constraint_weight * vertex_area_[vertices[i]];
     weighted_rows_ = w.asDiagonal() * rows_;
-    Eigen::MatrixXd N = rows_.transpose() * weighted_rows_;
-    N.diagonal() += hessian_;
-    soft_.compute(N);
+    // Update the normal matrix by the vertices that changed, or rebuild it when many did.
+    std::vector<char> next(basis_.rows(), 0);
+    for (const int v : vertices) next[v] = 1;
+    std::vector<int> added, removed;
+    if (!constrained_.empty()) {
+      for (int v = 0; v < static_cast<int>(basis_.rows()); ++v) {
+        if (next[v] && !constrained_[v]) added.push_back(v);
+        if (!next[v] && constrained_[v]) removed.push_back(v);
+      }
+    }
+    if (constrained_.empty() || 2 * (added.size() + removed.size()) > vertices.size()) {
+      normal_ = rows_.transpose() * weighted_rows_;
+      normal_.diagonal() += hessian_;
+    } else {
+      const auto update = [&](const std::vector<int>& changed, double sign) {
+        Eigen::MatrixXd H(changed.size(), m);
+        Eigen::VectorXd weight(changed.size());
+        for (size_t i = 0; i < changed.size(); ++i) {
+          H.row(i) = basis_.row(changed[i]);
+          weight[i] = sign * options_.constraint_weight * vertex_area_[changed[i]];
+        }
+        normal_.noalias() += H.transpose() * weight.asDiagonal() * H;
+      };
+      update(added, 1.0);
+      update(removed, -1.0);
+    }
+    constrained_ = std::move(next);
+    soft_.compute(normal_);
     if (soft_.info() != Eigen::Success) {
       throw SolverError(
           "the reduced system is singular: the constraints do not pin every "

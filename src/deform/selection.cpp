@@ -8,7 +8,14 @@
 namespace specdeform {
 
 ConstrainedSet constrained_set(const Selection& selection, const TriangleMesh& mesh) {
-  const int n = mesh.num_vertices();
+  int count = 0;
+  const Eigen::VectorXi components = vertex_components(mesh, &count);
+  return constrained_set(selection, components, count);
+}
+
+ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi& label,
+                               int components) {
+  const int n = static_cast<int>(label.size());
   ConstrainedSet set;
   set.num_groups = static_cast<int>(selection.handles.size());
   std::vector<int> owner(n, -2);
@@ -29,8 +36,6 @@ ConstrainedSet constrained_set(const Selection& selection, const TriangleMesh& m
     for (const int v : selection.handles[g]) add(v, g);
   for (const int v : selection.fixed) add(v, -1);
   if (set.vertices.empty()) throw InputError("selection: no handle and no fixed vertex");
-  int components = 0;
-  const Eigen::VectorXi label = vertex_components(mesh, &components);
   std::vector<char> pinned(components, 0);
   for (const int v : set.vertices) pinned[label[v]] = 1;
   for (int c = 0; c < components; ++c) {

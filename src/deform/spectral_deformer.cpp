@@ -5,6 +5,7 @@
 #include "specdeform/deform/reduced_solver.h"
 #include "specdeform/deform/spatial_solver.h"
 #include "specdeform/exceptions.h"
+#include "specdeform/mesh/mesh_info.h"
 #include "specdeform/operators/mass_matrix.h"
 #include "specdeform/spectral/spectral_transform.h"
 
@@ -46,6 +47,7 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh, ManifoldHarmonics basis,
     throw InputError("deformation: the constraint weight must be positive");
   }
   Clock clock;
+  components_ = vertex_components(mesh_, &num_components_);
   const Eigen::VectorXd area = lumped_mass(mesh_);
   if (has_basis) {
     base_ = harmonics_inverse(
@@ -72,7 +74,7 @@ SpectralDeformer& SpectralDeformer::operator=(SpectralDeformer&&) noexcept = def
 
 void SpectralDeformer::set_selection(const Selection& selection) {
   Clock clock;
-  constrained_ = constrained_set(selection, mesh_);
+  constrained_ = constrained_set(selection, components_, num_components_);
   const double start = clock.lap();
   if (reduced_) {
     reduced_->set_constraints(constrained_.vertices);

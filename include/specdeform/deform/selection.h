@@ -7,6 +7,7 @@
 
 #include <vector>
 
+#include <Eigen/Core>
 #include <Eigen/Geometry>
 
 #include "specdeform/mesh/triangle_mesh.h"
@@ -28,6 +29,10 @@ struct ConstrainedSet {
 // Throws InputError for an empty selection, an index out of [0, n), a vertex in two groups, or a
 // connected component of the mesh with no constrained vertex (its position would be undefined).
 ConstrainedSet constrained_set(const Selection& selection, const TriangleMesh& mesh);
+
+// The same with the mesh's vertex_components() computed beforehand (labels 0 .. count-1).
+ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi& components,
+                               int count);
 
 // Target position of every constrained vertex (|C| x 3): the group's transform applied to
 // `positions` (fixed vertices keep theirs). Throws InputError for a wrong number of transforms

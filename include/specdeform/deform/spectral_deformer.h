@@ -86,6 +86,8 @@ class SpectralDeformer {
   std::unique_ptr<ReducedSolver> reduced_;
   std::unique_ptr<SpatialSolver> spatial_;
   std::unique_ptr<DetailReconstruction> details_;
+  Eigen::VectorXi components_;  // connected component of each vertex
+  int num_components_ = 0;
   ConstrainedSet constrained_;
   Eigen::MatrixX3d detail_targets_;  // targets of the last solve, for constraint_error
   SetupTimings setup_;

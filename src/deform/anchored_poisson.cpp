@@ -1,0 +1,111 @@
+#include "anchored_poisson.h"
+
+#include <cholmod.h>
+
+#include <algorithm>
+
+#include <Eigen/CholmodSupport>
+
+#include "specdeform/exceptions.h"
+
+namespace specdeform::detail {
+
+namespace {
+
+using Sparse = Eigen::SparseMatrix<double>;
+
+}  // namespace
+
+AnchoredPoisson::AnchoredPoisson(const Sparse& K)
+    : K_(K), anchored_(K.rows(), 0), position_(K.rows()), common_(new cholmod_common) {
+  cholmod_start(common_);
+  common_->supernodal = CHOLMOD_SIMPLICIAL;  // rowadd and rowdel work on simplicial LDL^T
+  common_->final_ll = 0;
+  Sparse lower = K_.triangularView<Eigen::Lower>();
+  cholmod_sparse A = Eigen::viewAsCholmod(lower);
+  A.stype = -1;
+  factor_ = cholmod_analyze(&A, common_);
+  if (factor_ == nullptr) throw SolverError("deformation transfer: Poisson analysis failed");
+  const int* perm = static_cast<const int*>(factor_->Perm);
+  for (int k = 0; k < static_cast<int>(K_.rows()); ++k) position_[perm[k]] = k;
+}
+
+AnchoredPoisson::~AnchoredPoisson() {
+  cholmod_free_factor(&factor_, common_);
+  cholmod_finish(common_);
+  delete common_;
+}
+
+void AnchoredPoisson::factorize() {
+  Sparse A = K_;
+  for (int col = 0; col < A.outerSize(); ++col) {
+    for (Sparse::InnerIterator it(A, col); it; ++it) {
+      if (anchored_[col] || anchored_[it.row()]) it.valueRef() = it.row() == col ? 1.0 : 0.0;
+    }
+  }
+  Sparse lower = A.triangularView<Eigen::Lower>();
+  cholmod_sparse view = Eigen::viewAsCholmod(lower);
+  view.stype = -1;
+  cholmod_factorize(&view, factor_, common_);
+  if (common_->status != CHOLMOD_OK || factor_->minor < factor_->n) {
+    throw SolverError("deformation transfer: the Poisson system is singular");
+  }
+}
+
+// Puts row and column `vertex` of K back (restricted to the vertices not anchored now).
+void AnchoredPoisson::release(int vertex) {
+  anchored_[vertex] = 0;
+  std::vector<std::pair<int, double>> entries;
+  for (Sparse::InnerIterator it(K_, vertex); it; ++it) {
+    if (!anchored_[it.row()]) entries.emplace_back(position_[it.row()], it.value());
+  }
+  std::sort(entries.begin(), entries.end());
+  cholmod_sparse* R =
+      cholmod_allocate_sparse(K_.rows(), 1, entries.size(), 1, 1, 0, CHOLMOD_REAL, common_);
+  int* p = static_cast<int*>(R->p);
+  int* i = static_cast<int*>(R->i);
+  double* x = static_cast<double*>(R->x);
+  p[0] = 0;
+  p[1] = static_cast<int>(entries.size());
+  for (size_t e = 0; e < entries.size(); ++e) {
+    i[e] = entries[e].first;
+    x[e] = entries[e].second;
+  }
+  cholmod_rowadd(position_[vertex], R, factor_, common_);
+  cholmod_free_sparse(&R, common_);
+}
+
+void AnchoredPoisson::set_anchors(const std::vector<int>& anchors) {
+  std::vector<char> next(K_.rows(), 0);
+  for (const int v : anchors) next[v] = 1;
+  std::vector<int> add, remove;
+  for (int v = 0; v < static_cast<int>(K_.rows()); ++v) {
+    if (next[v] && !anchored_[v]) add.push_back(v);
+    if (!next[v] && anchored_[v]) remove.push_back(v);
+  }
+  if (!factored_ || 4 * (add.size() + remove.size()) > K_.rows()) {
+    anchored_ = std::move(next);
+    factorize();
+    factored_ = true;
+    return;
+  }
+  for (const int v : add) {
+    cholmod_rowdel(position_[v], nullptr, factor_, common_);
+    anchored_[v] = 1;
+  }
+  for (const int v : remove) release(v);
+  if (common_->status != CHOLMOD_OK) {
+    throw SolverError("deformation transfer: updating the Poisson factorisation failed");
+  }
+}
+
+Eigen::MatrixX3d AnchoredPoisson::solve(const Eigen::MatrixX3d& rhs) const {
+  Eigen::MatrixX3d b = rhs;
+  cholmod_dense B = Eigen::viewAsCholmod(b);
+  cholmod_dense* X = cholmod_solve(CHOLMOD_A, factor_, &B, common_);
+  Eigen::MatrixX3d out = Eigen::Map<Eigen::MatrixX3d>(static_cast<double*>(X->x), rhs.rows(), 3);
+  cholmod_free_dense(&X, common_);
+  return out;
+}
+
+}  // namespace specdeform::detail
