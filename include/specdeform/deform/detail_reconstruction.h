@@ -11,8 +11,9 @@
 //                  gradient S_f = [c'-a', b'-a', n'] [c-a, b-a, n]^-1 of s -> s' (unit normals),
 //                  applied to the gradients of x; then the Poisson system K x' = G^T D [S grad x]
 //                  on the detailed mesh, with the anchors (the constrained vertices) at their
-//                  exact targets. K is analysed once, factored (CHOLMOD, numeric only) once per
-//                  anchor set; a frame is O(f) plus one back-substitution with 3 columns.
+//                  exact targets. K is analysed once, factored (CHOLMOD LDL^T) for the first
+//                  anchor set and then updated by the anchors that change (row additions and
+//                  deletions); a frame is O(f) plus one back-substitution with 3 columns.
 // With s' = s every method returns x (to round-off).
 #pragma once
 

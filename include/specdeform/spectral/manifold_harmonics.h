@@ -13,7 +13,9 @@
 //  - BlockKrylov (default): shift-invert block Krylov-Schur with thick restarts. K - sigma M is
 //    factored once per band with CHOLMOD, each step solves for a whole block of right-hand sides,
 //    orthogonalisation is blocked (BLAS-3). For large m the spectrum is computed band by band
-//    (interior shifts, LDL^T), each band deflated against the pairs already found.
+//    (interior shifts, LDL^T with one step of iterative refinement), each band deflated
+//    against the pairs already found. K's null space (the constants of each connected
+//    component) is known exactly and deflated from the start.
 //  - Lanczos: Spectra's SymGEigsShiftSolver (implicitly restarted Lanczos, ncv = 2m + 1) on the
 //    same CHOLMOD shift-invert operator. The plain baseline.
 // Each eigenvector's sign is fixed so that its entry of largest magnitude is positive; random
