@@ -83,7 +83,7 @@ void AnchoredPoisson::set_anchors(const std::vector<int>& anchors) {
     if (next[v] && !anchored_[v]) add.push_back(v);
     if (!next[v] && anchored_[v]) remove.push_back(v);
   }
-  if (!factored_ || 4 * (add.size() + remove.size()) > K_.rows()) {
+  if (!factored_ || 4 * static_cast<Eigen::Index>(add.size() + remove.size()) > K_.rows()) {
     anchored_ = std::move(next);
     factorize();
     factored_ = true;
