@@ -129,7 +129,7 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
       for (int f = 0; f < nf; ++f) {
         const Eigen::Matrix3d m = triangle_frame(base, faces_, f);
         bool invertible = false;
-        Eigen::Matrix3d inv;
+        Eigen::Matrix3d inv = Eigen::Matrix3d::Zero();
         m.computeInverseWithCheck(inv, invertible, 1e-300);
         Eigen::Matrix3d corners = Eigen::Matrix3d::Zero();  // rows: corners, columns: x, y, z
         for (int k = 0; k < 3; ++k)
