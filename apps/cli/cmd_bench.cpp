@@ -94,10 +94,11 @@ nlohmann::ordered_json bench_mesh(const std::string& name, const TriangleMesh& m
 
   clock = Stopwatch();
   SpectralDeformer d(mesh, std::move(basis));
+  const double analysis = d.setup_timings().detail_factorization;  // once per mesh
   d.set_selection(scene.selection);
   const SetupTimings& setup = d.setup_timings();
   j["PT2_reduced_system"] = setup.reduced_system + (setup.selection - setup.detail_factorization);
-  j["PT3_detail_factorization"] = setup.detail_factorization;
+  j["PT3_detail_factorization"] = analysis + setup.detail_factorization;
   const FrameStats f = time_frames(d, scene, repeat);
   j["RT1_reduced_solve"] = f.reduced;
   j["inverse_transform"] = f.inverse;

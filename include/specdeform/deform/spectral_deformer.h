@@ -36,8 +36,10 @@ class SpatialSolver;
 
 // Seconds spent in each stage.
 struct SetupTimings {
-  double reduced_system = 0.0;        // spectral: Hessian and base; spatial: its factorisation
-  double detail_factorization = 0.0;  // Poisson analysis + factorisation (Transfer)
+  double reduced_system = 0.0;        // spectral: Hessian and base (once per mesh); spatial: its
+                                      // factorisation for the last selection
+  double detail_factorization = 0.0;  // Transfer: Poisson analysis (once per mesh), then the
+                                      // factorisation or its update for the last selection
   double selection = 0.0;             // the whole of the last set_selection()
 };
 
