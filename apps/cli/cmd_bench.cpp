@@ -24,11 +24,6 @@ namespace specdeform::cli {
 
 namespace {
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
-}
-
 double peak_rss_mb() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
@@ -57,23 +52,6 @@ BenchScene bench_scene(const TriangleMesh& mesh) {
   return s;
 }
 
-struct FrameStats {
-  double reduced = 0, inverse = 0, detail = 0, total = 0;
-};
-
-FrameStats time_frames(SpectralDeformer& d, const BenchScene& s, int repeat) {
-  std::vector<double> reduced, inverse, detail, total;
-  for (int r = 0; r < repeat; ++r) {
-    d.solve(s.transforms);
-    const FrameTimings& t = d.frame_timings();
-    reduced.push_back(t.reduced_solve);
-    inverse.push_back(t.inverse_transform);
-    detail.push_back(t.detail);
-    total.push_back(t.total);
-  }
-  return {median(reduced), median(inverse), median(detail), median(total)};
-}
-
 nlohmann::ordered_json bench_mesh(const std::string& name, const TriangleMesh& mesh, int modes,
                                   int repeat, const ManifoldHarmonicsOptions& harmonics) {
   const BenchScene scene = bench_scene(mesh);
@@ -99,9 +77,9 @@ nlohmann::ordered_json bench_mesh(const std::string& name, const TriangleMesh& m
   const SetupTimings& setup = d.setup_timings();
   j["PT2_reduced_system"] = setup.reduced_system + (setup.selection - setup.detail_factorization);
   j["PT3_detail_factorization"] = analysis + setup.detail_factorization;
-  const FrameStats f = time_frames(d, scene, repeat);
-  j["RT1_reduced_solve"] = f.reduced;
-  j["inverse_transform"] = f.inverse;
+  const FrameTimings f = median_frame(d, scene.transforms, repeat);
+  j["RT1_reduced_solve"] = f.reduced_solve;
+  j["inverse_transform"] = f.inverse_transform;
   j["RT2_detail"] = f.detail;
   j["frame"] = f.total;
   j["constraint_error_max"] = d.constraint_error(d.solve(scene.transforms)).max;
@@ -117,7 +95,7 @@ nlohmann::ordered_json bench_mesh(const std::string& name, const TriangleMesh& m
   reference.set_selection(scene.selection);
   reference.solve(scene.transforms);
   j["spatial_from_scratch"] = clock.seconds();
-  j["spatial_prefactored_frame"] = time_frames(reference, scene, repeat).total;
+  j["spatial_prefactored_frame"] = median_frame(reference, scene.transforms, repeat).total;
   j["peak_rss_MB"] = peak_rss_mb();
   return j;
 }

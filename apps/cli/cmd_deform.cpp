@@ -12,15 +12,6 @@
 
 namespace specdeform::cli {
 
-namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
-}
-
-}  // namespace
-
 void add_deform_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("deform", "deform a mesh by handles: spectral or spatial solve");
   struct Args {
@@ -101,15 +92,7 @@ void add_deform_command(CLI::App& app) {
     SpectralDeformer deformer(loaded.mesh, std::move(basis), options);
     deformer.set_selection(selection);
     Vertices result;
-    std::vector<double> reduced, inverse, detail, total;
-    for (int r = 0; r < args->repeat; ++r) {
-      result = deformer.solve(scene.transforms);
-      const FrameTimings& f = deformer.frame_timings();
-      reduced.push_back(f.reduced_solve);
-      inverse.push_back(f.inverse_transform);
-      detail.push_back(f.detail);
-      total.push_back(f.total);
-    }
+    const FrameTimings frame = median_frame(deformer, scene.transforms, args->repeat, &result);
     if (!result.allFinite()) throw SolverError("the deformation produced non-finite positions");
     write_mesh(args->output, to_file_order(loaded.info, result, loaded.mesh.F));
     const SetupTimings& s = deformer.setup_timings();
@@ -117,10 +100,10 @@ void add_deform_command(CLI::App& app) {
     timings["reduced_system"] = s.reduced_system;
     timings["detail_factorization"] = s.detail_factorization;
     timings["selection"] = s.selection;
-    timings["frame"] = {{"reduced_solve", median(reduced)},
-                        {"inverse_transform", median(inverse)},
-                        {"detail", median(detail)},
-                        {"total", median(total)}};
+    timings["frame"] = {{"reduced_solve", frame.reduced_solve},
+                        {"inverse_transform", frame.inverse_transform},
+                        {"detail", frame.detail},
+                        {"total", frame.total}};
     if (args->json) {
       nlohmann::ordered_json j;
       j["vertices"] = loaded.mesh.num_vertices();
@@ -136,7 +119,7 @@ void add_deform_command(CLI::App& app) {
       j["output"] = args->output;
       std::cout << j.dump() << "\n";
     } else {
-      std::cout << "wrote " << args->output << ": frame " << median(total) * 1e3
+      std::cout << "wrote " << args->output << ": frame " << frame.total * 1e3
                 << " ms, constraint error max " << e.max << " rms " << e.rms
                 << " (of the bounding-box diagonal)\n";
     }

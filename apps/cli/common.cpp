@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -121,6 +122,26 @@ LoadedScene load_scene(const std::string& mesh_path, const SceneArgs& args,
   out.scene.transforms = match_transforms(out.scene.selection, out.scene.transforms);
   out.selection = to_mesh_numbering(out.scene.selection, out.mesh.info);
   return out;
+}
+
+FrameTimings median_frame(SpectralDeformer& deformer,
+                          const std::vector<Eigen::Affine3d>& transforms, int repeat,
+                          Vertices* result) {
+  std::vector<double> reduced, inverse, detail, total;
+  for (int r = 0; r < repeat; ++r) {
+    Vertices frame = deformer.solve(transforms);
+    if (result != nullptr) *result = std::move(frame);
+    const FrameTimings& t = deformer.frame_timings();
+    reduced.push_back(t.reduced_solve);
+    inverse.push_back(t.inverse_transform);
+    detail.push_back(t.detail);
+    total.push_back(t.total);
+  }
+  const auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  return {median(reduced), median(inverse), median(detail), median(total)};
 }
 
 ManifoldHarmonics obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonicsOptions& options,

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "specdeform/deform/scene.h"
+#include "specdeform/deform/spectral_deformer.h"
 #include "specdeform/mesh/io.h"
 #include "specdeform/spectral/manifold_harmonics.h"
 
@@ -47,6 +48,11 @@ struct LoadedScene {
 };
 LoadedScene load_scene(const std::string& mesh_path, const SceneArgs& args,
                        const DeformOptions& defaults);
+
+// Solves the same frame `repeat` times; the median of each stage's time, and the last result.
+FrameTimings median_frame(SpectralDeformer& deformer,
+                          const std::vector<Eigen::Affine3d>& transforms, int repeat,
+                          Vertices* result = nullptr);
 
 class Stopwatch {
  public:
