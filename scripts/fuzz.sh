@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets with clang and runs each for SECONDS (default 60) from the seed
-# corpus in fuzz/corpus. Usage: scripts/fuzz.sh [SECONDS]
+# Builds the libFuzzer targets with clang and runs each for SECONDS (default 60) from its seed
+# corpus in fuzz/corpus/<target>. Usage: scripts/fuzz.sh [SECONDS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
@@ -12,7 +12,10 @@ CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=Release -DSPECDEFORM_BUI
 cmake --build build-fuzz -j "$(nproc)" >/dev/null
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-cp fuzz/corpus/* "$work/"
-build-fuzz/bin/fuzz_mesh_readers "$work" -max_total_time="$seconds" -max_len=4096 \
-  -rss_limit_mb=2048 -print_final_stats=1 2>&1 | grep -E "Done|ERROR|SUMMARY" 
-echo "fuzz: no crash in ${seconds}s"
+for target in mesh_readers editor_messages; do
+  mkdir "$work/$target"
+  cp fuzz/corpus/$target/* "$work/$target/"
+  build-fuzz/bin/fuzz_$target "$work/$target" -max_total_time="$seconds" -max_len=4096 \
+    -rss_limit_mb=2048 -print_final_stats=1 2>&1 | grep -E "Done|ERROR|SUMMARY"
+  echo "fuzz_$target: no crash in ${seconds}s"
+done

@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# Installs what specdeform needs on Debian 12 (idempotent), then configures and builds it.
+# Installs what specdeform needs on Debian 12 (idempotent), then configures and builds it: the
+# C++ library, program, tests and benchmarks, and the browser editor (web/dist, with Vite).
 # Usage: scripts/setup.sh [build-dir]      (default: build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
 
 packages=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libopenblas-dev
-          libspectra-dev libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev)
+          libspectra-dev libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev libboost-dev)
+command -v npm >/dev/null || packages+=(nodejs npm)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -18,6 +20,12 @@ if [ ${#missing[@]} -gt 0 ]; then
   $sudo_cmd apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${missing[@]}" >/dev/null
 fi
+
+# The editor's npm packages, pinned by web/package-lock.json; reinstalled when the lock changes.
+if [ ! web/node_modules/.package-lock.json -nt web/package-lock.json ]; then
+  (cd web && npm ci --no-audit --no-fund --loglevel=error)
+fi
+(cd web && npm run --silent build >/dev/null)
 
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$build" -j "$(nproc)"

@@ -23,15 +23,6 @@ void add_deform_command(CLI::App& app) {
     ManifoldHarmonicsOptions harmonics;
   };
   auto args = std::make_shared<Args>();
-  static const std::map<std::string, DetailMethod> kDetail{
-      {"none", DetailMethod::None},
-      {"displacement", DetailMethod::Displacement},
-      {"frames", DetailMethod::Frames},
-      {"transfer", DetailMethod::Transfer}};
-  static const std::map<std::string, DeformSolver> kSolver{{"spectral", DeformSolver::Spectral},
-                                                           {"spatial", DeformSolver::Spatial}};
-  static const std::map<std::string, ConstraintMode> kConstraints{{"soft", ConstraintMode::Soft},
-                                                                  {"hard", ConstraintMode::Hard}};
   cmd->add_option("MESH", args->mesh, "mesh file (optional with a --scene that names one)");
   cmd->add_option("-o,--output", args->output, "deformed mesh to write")->required();
   args->scene.add_to(*cmd);
@@ -44,11 +35,11 @@ void add_deform_command(CLI::App& app) {
       ->check(kPositive);
   cmd->add_option("--detail", args->options.detail,
                   "none | displacement | frames | transfer (default)")
-      ->transform(CLI::CheckedTransformer(kDetail, CLI::ignore_case));
+      ->transform(CLI::CheckedTransformer(kDetailNames, CLI::ignore_case));
   cmd->add_option("--solver", args->options.solver, "spectral (default) | spatial (reference)")
-      ->transform(CLI::CheckedTransformer(kSolver, CLI::ignore_case));
+      ->transform(CLI::CheckedTransformer(kSolverNames, CLI::ignore_case));
   cmd->add_option("--constraints", args->options.constraints, "soft (default) | hard")
-      ->transform(CLI::CheckedTransformer(kConstraints, CLI::ignore_case));
+      ->transform(CLI::CheckedTransformer(kConstraintNames, CLI::ignore_case));
   cmd->add_flag("--float32", args->options.float32_basis, "single-precision basis in the frame");
   cmd->add_option("--basis", args->basis,
                   "basis cache: read if it exists (and matches the mesh), written otherwise");

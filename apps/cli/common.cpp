@@ -36,6 +36,15 @@ CLI::Validator number_check(bool allow_zero) {
 const CLI::Validator kPositive = number_check(false);
 const CLI::Validator kNonNegative = number_check(true);
 
+const std::map<std::string, DetailMethod> kDetailNames{{"none", DetailMethod::None},
+                                                       {"displacement", DetailMethod::Displacement},
+                                                       {"frames", DetailMethod::Frames},
+                                                       {"transfer", DetailMethod::Transfer}};
+const std::map<std::string, DeformSolver> kSolverNames{{"spectral", DeformSolver::Spectral},
+                                                       {"spatial", DeformSolver::Spatial}};
+const std::map<std::string, ConstraintMode> kConstraintNames{{"soft", ConstraintMode::Soft},
+                                                             {"hard", ConstraintMode::Hard}};
+
 LoadedMesh load_mesh(const std::string& path) {
   LoadedMesh loaded = read_mesh(path);
   const MeshReadInfo& info = loaded.info;

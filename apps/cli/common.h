@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <map>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -18,6 +19,11 @@ namespace specdeform::cli {
 extern const CLI::Validator kPositive;
 // Accepts a number >= 0.
 extern const CLI::Validator kNonNegative;
+
+// Option values of the deformation settings.
+extern const std::map<std::string, DetailMethod> kDetailNames;
+extern const std::map<std::string, DeformSolver> kSolverNames;
+extern const std::map<std::string, ConstraintMode> kConstraintNames;
 
 // Reads a mesh; what the reader dropped or merged is reported on stderr.
 LoadedMesh load_mesh(const std::string& path);
@@ -73,5 +79,6 @@ void add_demo_command(CLI::App& app);
 void add_deform_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_converge_command(CLI::App& app);
+void add_edit_command(CLI::App& app);
 
 }  // namespace specdeform::cli

@@ -23,9 +23,9 @@ std::string read_text(const std::filesystem::path& path) {
   return s.str();
 }
 
-// Whitespace-separated values of a text file, '#' lines skipped.
-std::vector<std::string> tokens(const std::filesystem::path& path, bool skip_comments) {
-  std::istringstream in(read_text(path));
+// Whitespace-separated values of a text, '#' lines skipped.
+std::vector<std::string> tokens(std::string_view text, bool skip_comments) {
+  std::istringstream in{std::string(text)};
   std::vector<std::string> out;
   std::string line;
   while (std::getline(in, line)) {
@@ -37,7 +37,7 @@ std::vector<std::string> tokens(const std::filesystem::path& path, bool skip_com
   return out;
 }
 
-long long to_integer(const std::string& t, const std::filesystem::path& path) {
+long long to_integer(const std::string& t, std::string_view name) {
   size_t used = 0;
   long long v = 0;
   try {
@@ -45,11 +45,11 @@ long long to_integer(const std::string& t, const std::filesystem::path& path) {
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used != t.size()) throw InputError(path.string() + ": '" + t + "' is not an integer");
+  if (used != t.size()) throw InputError(std::string(name) + ": '" + t + "' is not an integer");
   return v;
 }
 
-double to_number(const std::string& t, const std::filesystem::path& path) {
+double to_number(const std::string& t, std::string_view name) {
   size_t used = 0;
   double v = 0;
   try {
@@ -58,15 +58,15 @@ double to_number(const std::string& t, const std::filesystem::path& path) {
     used = 0;
   }
   if (used != t.size() || !std::isfinite(v)) {
-    throw InputError(path.string() + ": '" + t + "' is not a finite number");
+    throw InputError(std::string(name) + ": '" + t + "' is not a finite number");
   }
   return v;
 }
 
-void check_count(size_t got, int expected, const std::filesystem::path& path) {
+void check_count(size_t got, int expected, std::string_view name) {
   if (static_cast<long long>(got) != expected) {
-    throw InputError(path.string() + ": " + std::to_string(got) + " vertex entries, the mesh has " +
-                     std::to_string(expected) + " vertices");
+    throw InputError(std::string(name) + ": " + std::to_string(got) +
+                     " vertex entries, the mesh has " + std::to_string(expected) + " vertices");
   }
 }
 
@@ -84,40 +84,42 @@ Eigen::Affine3d checked_transform(const Eigen::Matrix4d& m, const std::string& w
 
 }  // namespace
 
-Selection read_sel(const std::filesystem::path& path, int file_vertices) {
-  const std::vector<std::string> t = tokens(path, true);
-  check_count(t.size(), file_vertices, path);
+Selection parse_sel(std::string_view text, int file_vertices, std::string_view name) {
+  const std::vector<std::string> t = tokens(text, true);
+  check_count(t.size(), file_vertices, name);
   Selection s;
   s.handles.resize(1);
   for (size_t i = 0; i < t.size(); ++i) {
-    const long long status = to_integer(t[i], path);
+    const long long status = to_integer(t[i], name);
     if (status == 0) {
       s.fixed.push_back(static_cast<int>(i));
     } else if (status == 2) {
       s.handles[0].push_back(static_cast<int>(i));
     } else if (status != 1) {
-      throw InputError(path.string() + ": status " + std::to_string(status) + " of vertex " +
+      throw InputError(std::string(name) + ": status " + std::to_string(status) + " of vertex " +
                        std::to_string(i) + " is not 0 (fixed), 1 (free) or 2 (handle)");
     }
   }
   return s;
 }
 
-Selection read_dmat(const std::filesystem::path& path, int file_vertices) {
-  const std::vector<std::string> t = tokens(path, false);
-  if (t.size() < 2) throw InputError(path.string() + ": not a .dmat file (no 'cols rows' header)");
-  const long long cols = to_integer(t[0], path), rows = to_integer(t[1], path);
+Selection parse_dmat(std::string_view text, int file_vertices, std::string_view name) {
+  const std::vector<std::string> t = tokens(text, false);
+  if (t.size() < 2) {
+    throw InputError(std::string(name) + ": not a .dmat file (no 'cols rows' header)");
+  }
+  const long long cols = to_integer(t[0], name), rows = to_integer(t[1], name);
   if (cols != 1 || rows < 0) {
-    throw InputError(path.string() + ": expected one column of per-vertex values, got " +
+    throw InputError(std::string(name) + ": expected one column of per-vertex values, got " +
                      std::to_string(cols) + " x " + std::to_string(rows));
   }
-  check_count(t.size() - 2, file_vertices, path);
-  if (rows != file_vertices) check_count(static_cast<size_t>(rows), file_vertices, path);
+  check_count(t.size() - 2, file_vertices, name);
+  if (rows != file_vertices) check_count(static_cast<size_t>(rows), file_vertices, name);
   Selection s;
   for (size_t i = 2; i < t.size(); ++i) {
-    const long long g = to_integer(t[i], path);
+    const long long g = to_integer(t[i], name);
     if (g < -1 || g > 1000) {
-      throw InputError(path.string() + ": group " + std::to_string(g) + " of vertex " +
+      throw InputError(std::string(name) + ": group " + std::to_string(g) + " of vertex " +
                        std::to_string(i - 2) + " is not -1 (free) or a group number");
     }
     if (g < 0) continue;
@@ -125,6 +127,14 @@ Selection read_dmat(const std::filesystem::path& path, int file_vertices) {
     s.handles[g].push_back(static_cast<int>(i - 2));
   }
   return s;
+}
+
+Selection read_sel(const std::filesystem::path& path, int file_vertices) {
+  return parse_sel(read_text(path), file_vertices, path.string());
+}
+
+Selection read_dmat(const std::filesystem::path& path, int file_vertices) {
+  return parse_dmat(read_text(path), file_vertices, path.string());
 }
 
 std::vector<Eigen::Affine3d> read_def(const std::filesystem::path& path) {
@@ -148,7 +158,7 @@ std::vector<Eigen::Affine3d> read_def(const std::filesystem::path& path) {
   std::vector<Eigen::Affine3d> out;
   for (size_t k = 0; k < t.size(); k += 16) {
     Eigen::Matrix4d m;
-    for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = to_number(t[k + i], path);
+    for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = to_number(t[k + i], path.string());
     out.push_back(checked_transform(m, path.string() + " (matrix " + std::to_string(k / 16) + ")"));
   }
   return out;
@@ -383,6 +393,30 @@ Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertice
                                                {"spatial", DeformSolver::Spatial}});
   }
   return scene;
+}
+
+std::string encode_scene(const Scene& scene) {
+  Json j = Json::object();
+  if (!scene.mesh.empty()) j["mesh"] = scene.mesh.generic_string();
+  const std::vector<Eigen::Affine3d> transforms =
+      match_transforms(scene.selection, scene.transforms);
+  j["handles"] = Json::array();
+  for (size_t g = 0; g < scene.selection.handles.size(); ++g) {
+    const Eigen::Matrix4d m = transforms[g].matrix();
+    Json rows = Json::array();
+    for (int r = 0; r < 4; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
+    j["handles"].push_back({{"vertices", scene.selection.handles[g]}, {"transform", rows}});
+  }
+  j["fixed"] = scene.selection.fixed;
+  const DeformOptions& o = scene.options;
+  Json settings = {{"ks", o.ks}, {"kb", o.kb}, {"constraint_weight", o.constraint_weight}};
+  if (scene.modes) settings["modes"] = *scene.modes;
+  settings["constraints"] = o.constraints == ConstraintMode::Soft ? "soft" : "hard";
+  settings["solver"] = o.solver == DeformSolver::Spectral ? "spectral" : "spatial";
+  constexpr const char* kDetail[] = {"none", "displacement", "frames", "transfer"};
+  settings["detail"] = kDetail[static_cast<int>(o.detail)];
+  j["settings"] = settings;
+  return j.dump(1) + "\n";
 }
 
 }  // namespace specdeform

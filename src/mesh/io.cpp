@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <numeric>
 #include <sstream>
 
 #include "polygon_soup.h"
@@ -113,6 +114,17 @@ LoadedMesh read_mesh(const std::filesystem::path& path) {
   bytes << file.rdbuf();
   if (file.bad()) throw InputError(path.string() + ": read error");
   return read_mesh_from_memory(bytes.str(), format, path.string());
+}
+
+MeshReadInfo identity_read_info(const TriangleMesh& mesh) {
+  MeshReadInfo info;
+  info.file_vertices = mesh.V;
+  info.file_faces = mesh.num_faces();
+  info.vertex_to_file.resize(mesh.num_vertices());
+  std::iota(info.vertex_to_file.begin(), info.vertex_to_file.end(), 0);
+  info.face_to_file.resize(mesh.num_faces());
+  std::iota(info.face_to_file.begin(), info.face_to_file.end(), 0);
+  return info;
 }
 
 TriangleMesh to_file_order(const MeshReadInfo& info, const Vertices& V, const Faces& F) {

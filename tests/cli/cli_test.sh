@@ -59,5 +59,9 @@ grep -q '"displacement_vs_spatial"' "$tmp/conv.json" && [ -s "$tmp/conv/m40_defo
   { echo "FAIL: converge wrote no table or meshes"; fails=$((fails + 1)); }
 expect 0 "$bin" demo -o "$tmp/demo" -m 40
 [ -s "$tmp/demo/4_deformed.obj" ] || { echo "FAIL: demo wrote no deformed mesh"; fails=$((fails + 1)); }
+expect 1 "$bin" edit "$tmp/missing.obj" --port 0
+expect 1 "$bin" edit --assets "$tmp/nowhere" --port 0
+expect 1 "$bin" edit --host not-an-address --port 0 --assets "$tmp"
+expect 2 "$bin" edit --port 70000
 [ "$fails" = 0 ] && echo "cli tests passed"
 exit "$fails"

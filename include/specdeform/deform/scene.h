@@ -48,12 +48,19 @@ struct Scene {
 Selection read_sel(const std::filesystem::path& path, int file_vertices);
 // .dmat: handle group k = the vertices with value k.
 Selection read_dmat(const std::filesystem::path& path, int file_vertices);
+// The same from a file's contents; `name` prefixes error messages.
+Selection parse_sel(std::string_view text, int file_vertices, std::string_view name);
+Selection parse_dmat(std::string_view text, int file_vertices, std::string_view name);
 // .def: the transforms, in order.
 std::vector<Eigen::Affine3d> read_def(const std::filesystem::path& path);
 // JSON scene; `file_vertices` are the positions of the mesh's file vertices (for "centroid").
 // `options` are the defaults the scene's settings override.
 Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertices,
                  const DeformOptions& options = {});
+
+// The scene as JSON in the format above (vertex lists, 4 x 4 transforms, the fixed list and the
+// settings); read_scene() reads it back to the same selection, transforms and settings.
+std::string encode_scene(const Scene& scene);
 
 // Pads `transforms` with identities up to the number of handle groups; throws InputError if
 // there are more transforms than groups or the selection has no handle vertex.

@@ -56,6 +56,10 @@ LoadedMesh read_mesh(const std::filesystem::path& path);
 // Parses a file held in memory; `name` is used in error messages only.
 LoadedMesh read_mesh_from_memory(std::string_view data, MeshFormat format, std::string_view name);
 
+// What reading `mesh` from a file would record when nothing is dropped or merged (for meshes
+// made in memory, e.g. by generate.h).
+MeshReadInfo identity_read_info(const TriangleMesh& mesh);
+
 // The mesh in the file's numbering: vertex positions V (one row per mesh vertex) placed at their
 // file indices, dropped vertices at their file positions, and the faces renumbered accordingly.
 TriangleMesh to_file_order(const MeshReadInfo& info, const Vertices& V, const Faces& F);

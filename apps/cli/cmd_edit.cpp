@@ -1,0 +1,80 @@
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+
+#include "common.h"
+#include "editor_server.h"
+#include "specdeform/mesh/generate.h"
+
+namespace specdeform::cli {
+
+namespace {
+
+std::filesystem::path default_cache_dir() {
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg != '\0') {
+    return std::filesystem::path(xdg) / "specdeform";
+  }
+  if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0') {
+    return std::filesystem::path(home) / ".cache" / "specdeform";
+  }
+  return {};
+}
+
+}  // namespace
+
+void add_edit_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("edit", "open the browser editor on a mesh (default: the demo)");
+  struct Args {
+    std::string mesh;
+    server::ServerConfig server;
+    server::EditorConfig editor;
+    double max_upload_mb = 256;
+    bool no_cache = false;
+  };
+  auto args = std::make_shared<Args>();
+  args->server.assets = SPECDEFORM_WEB_DIST;
+  args->editor.cache_dir = default_cache_dir();
+  cmd->add_option("MESH", args->mesh, "mesh to open (default: the built-in bumpy bar)");
+  cmd->add_option("--host", args->server.host,
+                  "address to listen on (default 127.0.0.1: this machine only)");
+  cmd->add_option("--port", args->server.port, "port (default 8080; 0: any free port)");
+  cmd->add_option("-m,--modes", args->editor.modes, "manifold harmonics used (default 100)")
+      ->check(CLI::Range(1, 5000));
+  cmd->add_option("--ks", args->editor.options.ks, "stretching weight (default 0)")
+      ->check(kNonNegative);
+  cmd->add_option("--kb", args->editor.options.kb, "bending weight (default 1)")
+      ->check(kNonNegative);
+  cmd->add_option("--detail", args->editor.options.detail,
+                  "none | displacement | frames | transfer (default)")
+      ->transform(CLI::CheckedTransformer(kDetailNames, CLI::ignore_case));
+  cmd->add_option("--constraints", args->editor.options.constraints, "soft (default) | hard")
+      ->transform(CLI::CheckedTransformer(kConstraintNames, CLI::ignore_case));
+  cmd->add_option("--cache-dir", args->editor.cache_dir,
+                  "where bases are cached (default ~/.cache/specdeform)");
+  cmd->add_flag("--no-cache", args->no_cache, "neither read nor write cached bases");
+  cmd->add_option("--max-upload-mb", args->max_upload_mb,
+                  "largest mesh file the browser may send (default 256)")
+      ->check(kPositive);
+  cmd->add_option("--assets", args->server.assets, "the built editor (default: web/dist)");
+  cmd->callback([args] {
+    if (args->no_cache) args->editor.cache_dir.clear();
+    args->server.max_message_bytes = static_cast<size_t>(args->max_upload_mb * (1 << 20));
+    server::EditorServer editor(args->server, args->editor);
+    LoadedMesh mesh;
+    std::string name = "bumpy-bar.obj";
+    if (args->mesh.empty()) {
+      mesh.mesh = make_bumpy_bar();
+      mesh.info = identity_read_info(mesh.mesh);
+    } else {
+      mesh = load_mesh(args->mesh);
+      name = std::filesystem::path(args->mesh).filename().string();
+    }
+    std::cerr << name << ": " << mesh.mesh.num_vertices()
+              << " vertices; preparing m = " << args->editor.modes << " manifold harmonics\n";
+    editor.session().open(std::move(mesh), name);
+    std::cout << "specdeform editor: " << editor.url() << "  (Ctrl-C stops it)" << std::endl;
+    editor.run();
+  });
+}
+
+}  // namespace specdeform::cli

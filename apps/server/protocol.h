@@ -1,0 +1,86 @@
+// The editor's WebSocket protocol: binary messages for everything sized by the mesh, JSON text
+// messages for the rest. Pure encoding and decoding, no networking; the decoders validate every
+// field and throw InputError with a one-line reason.
+//
+// Binary messages are little-endian, start with a u32 tag, and keep every array aligned to its
+// element size, so the browser reads them with typed arrays in place.
+//
+// Browser -> server
+//   1 selection    u32 tag | u32 groups G | u32 fixed F | u32 size of each group (G) |
+//                  u32 fixed vertices (F) | u32 vertices of group 0, 1, ... (mesh numbering)
+//   2 frame        u32 tag | u32 seq | u32 groups G | u32 0 | f64 4 x 4 row-major transform of
+//                  each group (16 G), acting on the mesh's rest positions
+//   3 mesh file    u32 tag | u32 name length L | name (L bytes, padded with zeros to 4) | file
+//   4 selection    the same layout as 3, for a .sel or .dmat file (file numbering)
+// Server -> browser
+//   101 mesh       u32 tag | u32 n | u32 triangles T | f32 positions (3 n) | u32 corners (3 T)
+//   102 frame      u32 tag | u32 seq | u32 n | u32 view (0 detailed, 1 smooth base) |
+//                  f32 reduced solve, inverse transform, detail, total (ms) |
+//                  f32 constraint error max, rms (over the bounding-box diagonal) |
+//                  f32 positions (3 n)
+//   103 file       the layout of 3: an export for the browser to save
+//   104 selection  the layout of 1: a selection file read for the browser to adopt
+// Text (JSON objects with a "type"): see editor_session.h.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "specdeform/deform/selection.h"
+#include "specdeform/mesh/triangle_mesh.h"
+
+namespace specdeform::server {
+
+enum class Tag : uint32_t {
+  Selection = 1,
+  Frame = 2,
+  MeshFile = 3,
+  SelectionFile = 4,
+  Mesh = 101,
+  FrameResult = 102,
+  File = 103,
+  SelectionResult = 104,
+};
+
+// Limits that bound what a message can make the server allocate.
+inline constexpr uint32_t kMaxGroups = 64;
+inline constexpr uint32_t kMaxNameLength = 1024;
+
+struct FrameRequest {
+  uint32_t seq = 0;
+  std::vector<Eigen::Affine3d> transforms;  // one per handle group
+};
+
+struct NamedFile {
+  std::string name;
+  std::string data;
+};
+
+struct FrameStats {
+  double reduced_solve = 0, inverse_transform = 0, detail = 0, total = 0;  // seconds
+  double error_max = 0, error_rms = 0;
+};
+
+// The tag of a binary message; throws InputError for one shorter than a tag.
+Tag message_tag(std::string_view message);
+
+// Throws InputError for a wrong length, too many groups, or an index out of [0, n).
+Selection decode_selection(std::string_view message, int num_vertices);
+// Throws InputError for a wrong length, a group count other than `num_groups`, or a transform
+// that is not finite, not affine (last row 0 0 0 1) or not invertible.
+FrameRequest decode_frame(std::string_view message, int num_groups);
+// Throws InputError for a wrong length or a name that is empty, too long or not printable.
+NamedFile decode_file(std::string_view message);
+
+std::string encode_selection(const Selection& selection, Tag tag = Tag::SelectionResult);
+std::string encode_frame(const FrameRequest& frame);
+std::string encode_file(const NamedFile& file, Tag tag = Tag::File);
+std::string encode_mesh_message(const TriangleMesh& mesh);
+std::string encode_frame_result(uint32_t seq, bool base_view, const FrameStats& stats,
+                                const Vertices& positions);
+
+}  // namespace specdeform::server

@@ -1,0 +1,155 @@
+#include "editor_server.h"
+
+#include <utility>  // before Boost.Asio, whose awaitable.hpp uses std::exchange
+
+#include <fstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <boost/asio.hpp>
+#include <boost/beast.hpp>
+#include <nlohmann/json.hpp>
+
+#include "protocol.h"
+#include "specdeform/mesh/generate.h"
+
+namespace specdeform::server {
+namespace {
+
+namespace net = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = net::ip::tcp;
+
+// A server on a free port of 127.0.0.1, serving a small sphere and two asset files, on a thread.
+class EditorServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    assets_ = std::filesystem::temp_directory_path() /
+              ("specdeform-assets-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(assets_ / "assets");
+    std::ofstream(assets_ / "index.html") << "<!doctype html><title>editor</title>";
+    std::ofstream(assets_ / "assets" / "app.js") << "console.log(1)";
+    std::filesystem::create_symlink("/etc/hostname", assets_ / "linked.txt");
+    server_ = std::make_unique<EditorServer>(
+        ServerConfig{.port = 0, .assets = assets_, .max_message_bytes = 1 << 20},
+        EditorConfig{.modes = 20});
+    LoadedMesh mesh;
+    mesh.mesh = make_icosphere(2);
+    mesh.info = identity_read_info(mesh.mesh);
+    server_->session().open(std::move(mesh), "sphere.obj");
+    thread_ = std::thread([this] { server_->run(); });
+  }
+
+  void TearDown() override {
+    server_->stop();
+    thread_.join();
+    std::filesystem::remove_all(assets_);
+  }
+
+  http::response<http::string_body> get(const std::string& target, const std::string& host = "",
+                                        http::verb verb = http::verb::get) {
+    net::io_context io;
+    beast::tcp_stream stream(io);
+    stream.connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), server_->port()));
+    http::request<http::string_body> req{verb, target, 11};
+    req.set(http::field::host,
+            host.empty() ? "127.0.0.1:" + std::to_string(server_->port()) : host);
+    http::write(stream, req);
+    beast::flat_buffer buffer;
+    http::response<http::string_body> res;
+    http::read(stream, buffer, res);
+    return res;
+  }
+
+  // Opens a WebSocket with the given Origin; throws if the handshake is refused.
+  std::unique_ptr<websocket::stream<tcp::socket>> connect(const std::string& origin) {
+    auto ws = std::make_unique<websocket::stream<tcp::socket>>(io_);
+    ws->next_layer().connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), server_->port()));
+    ws->set_option(websocket::stream_base::decorator(
+        [origin](websocket::request_type& req) { req.set(http::field::origin, origin); }));
+    ws->handshake("127.0.0.1:" + std::to_string(server_->port()), "/ws");
+    return ws;
+  }
+
+  std::string own_origin() const { return "http://127.0.0.1:" + std::to_string(server_->port()); }
+
+  // Reads messages until a text message of `type` arrives.
+  static nlohmann::json read_until(websocket::stream<tcp::socket>& ws, const std::string& type) {
+    for (;;) {
+      beast::flat_buffer buffer;
+      ws.read(buffer);
+      if (ws.got_binary()) continue;
+      nlohmann::json j = nlohmann::json::parse(beast::buffers_to_string(buffer.data()));
+      if (j["type"] == type) return j;
+    }
+  }
+
+  std::filesystem::path assets_;
+  std::unique_ptr<EditorServer> server_;
+  std::thread thread_;
+  net::io_context io_;
+};
+
+TEST_F(EditorServerTest, ServesOnlyTheBuiltAssets) {
+  EXPECT_EQ(get("/").result(), http::status::ok);
+  EXPECT_EQ(get("/").body(), "<!doctype html><title>editor</title>");
+  const auto js = get("/assets/app.js?v=1");
+  EXPECT_EQ(js.result(), http::status::ok);
+  EXPECT_EQ(js[http::field::content_type], "text/javascript");
+  EXPECT_EQ(get("/../../etc/passwd").result(), http::status::not_found);
+  EXPECT_EQ(get("/assets/../index.html").result(), http::status::not_found);
+  EXPECT_EQ(get("/linked.txt").result(), http::status::not_found);
+  EXPECT_EQ(get("/", "evil.example:80").result(), http::status::forbidden);
+  EXPECT_EQ(get("/", "", http::verb::post).result(), http::status::method_not_allowed);
+  EXPECT_EQ(get("/", "localhost:" + std::to_string(server_->port())).result(), http::status::ok);
+}
+
+TEST_F(EditorServerTest, RefusesWebSocketsFromOtherOrigins) {
+  EXPECT_THROW(connect("http://evil.example"), boost::system::system_error);
+  EXPECT_THROW(connect(""), boost::system::system_error);
+  EXPECT_NO_THROW(connect(own_origin()));
+}
+
+TEST_F(EditorServerTest, AnswersMessagesAndSurvivesBadOnes) {
+  auto ws = connect(own_origin());
+  EXPECT_EQ(read_until(*ws, "ready")["vertices"], 162);
+  ws->binary(true);
+  ws->write(net::buffer(std::string("\x02\0\0", 3)));
+  EXPECT_NE(read_until(*ws, "error")["message"].get<std::string>().find("truncated"),
+            std::string::npos);
+  ws->write(net::buffer(encode_selection({{{0, 1}}, {100}}, Tag::Selection)));
+  EXPECT_EQ(read_until(*ws, "selection")["handles"][0], 2);
+}
+
+TEST_F(EditorServerTest, ClosesAConnectionThatSendsTooMuch) {
+  auto ws = connect(own_origin());
+  read_until(*ws, "ready");
+  ws->binary(true);
+  boost::system::error_code ec;
+  ws->write(net::buffer(std::string(2 << 20, 'x')), ec);  // may fail half-way: the server hangs up
+  beast::flat_buffer buffer;
+  ec = {};
+  while (!ec) ws->read(buffer, ec);
+  // The server sends "too big" (1009) and hangs up; answering its close may find the pipe broken.
+  EXPECT_EQ(ws->reason().code, websocket::close_code::too_big) << ec.message();
+}
+
+TEST_F(EditorServerTest, ANewWindowTakesOver) {
+  auto first = connect(own_origin());
+  read_until(*first, "ready");
+  auto second = connect(own_origin());
+  read_until(*second, "ready");
+  beast::flat_buffer buffer;
+  boost::system::error_code ec;
+  while (!ec) first->read(buffer, ec);
+  EXPECT_EQ(ec, websocket::error::closed);
+}
+
+TEST(EditorServer, ReportsMissingAssetsAndBusyPorts) {
+  EXPECT_THROW(EditorServer(ServerConfig{.assets = "/nonexistent"}, EditorConfig{}), InputError);
+}
+
+}  // namespace
+}  // namespace specdeform::server

@@ -1,0 +1,92 @@
+#include "protocol.h"
+
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "specdeform/exceptions.h"
+
+namespace specdeform::server {
+namespace {
+
+TEST(Protocol, SelectionRoundTrips) {
+  const Selection s{{{3, 1}, {}, {7}}, {0, 5}};
+  const Selection back = decode_selection(encode_selection(s, Tag::Selection), 8);
+  EXPECT_EQ(back.handles, s.handles);
+  EXPECT_EQ(back.fixed, s.fixed);
+}
+
+TEST(Protocol, SelectionRejectsBadMessages) {
+  const std::string good = encode_selection({{{3, 1}}, {0}}, Tag::Selection);
+  EXPECT_THROW(decode_selection(good, 3), InputError);  // vertex 3 of a 3-vertex mesh
+  EXPECT_THROW(decode_selection(good.substr(0, good.size() - 4), 8), InputError);
+  EXPECT_THROW(decode_selection(good + std::string(4, '\0'), 8), InputError);
+  EXPECT_THROW(decode_selection(good.substr(0, 6), 8), InputError);
+  Selection many;
+  many.handles.resize(kMaxGroups + 1);
+  EXPECT_THROW(decode_selection(encode_selection(many, Tag::Selection), 8), InputError);
+  // A group size that would overflow 32 bits when multiplied by 4.
+  std::string huge = encode_selection({{{}}, {}}, Tag::Selection);
+  const uint32_t big = 0x40000001;
+  huge.replace(12, 4, reinterpret_cast<const char*>(&big), 4);
+  EXPECT_THROW(decode_selection(huge, 8), InputError);
+}
+
+TEST(Protocol, FrameRoundTripsAndValidates) {
+  Eigen::Affine3d t =
+      Eigen::Translation3d(1, 2, 3) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY());
+  const FrameRequest f{42, {t, Eigen::Affine3d::Identity()}};
+  const FrameRequest back = decode_frame(encode_frame(f), 2);
+  EXPECT_EQ(back.seq, 42u);
+  ASSERT_EQ(back.transforms.size(), 2u);
+  EXPECT_TRUE(back.transforms[0].matrix().isApprox(t.matrix(), 0));
+  EXPECT_THROW(decode_frame(encode_frame(f), 1), InputError);  // group count mismatch
+
+  const auto with = [&](int entry, double value) {
+    FrameRequest g = f;
+    g.transforms[0].matrix()(entry / 4, entry % 4) = value;
+    return encode_frame(g);
+  };
+  EXPECT_THROW(decode_frame(with(5, std::numeric_limits<double>::quiet_NaN()), 2), InputError);
+  EXPECT_THROW(decode_frame(with(3, std::numeric_limits<double>::infinity()), 2), InputError);
+  EXPECT_THROW(decode_frame(with(12, 0.5), 2), InputError);  // not affine
+  FrameRequest singular = f;
+  singular.transforms[0].linear().setZero();
+  EXPECT_THROW(decode_frame(encode_frame(singular), 2), InputError);
+  const std::string good = encode_frame(f);
+  EXPECT_THROW(decode_frame(good.substr(0, good.size() - 8), 2), InputError);
+}
+
+TEST(Protocol, FileRoundTripsAndValidates) {
+  const NamedFile f{"bunny.obj", std::string("v 0 0 0\n\0binary", 15)};
+  const NamedFile back = decode_file(encode_file(f, Tag::MeshFile));
+  EXPECT_EQ(back.name, f.name);
+  EXPECT_EQ(back.data, f.data);
+  EXPECT_THROW(decode_file(encode_file({"", "x"}, Tag::MeshFile)), InputError);
+  EXPECT_THROW(decode_file(encode_file({"a\nb.obj", "x"}, Tag::MeshFile)), InputError);
+  EXPECT_THROW(decode_file(encode_file({std::string(kMaxNameLength + 1, 'a'), ""}, Tag::MeshFile)),
+               InputError);
+  EXPECT_THROW(decode_file(encode_file(f, Tag::MeshFile).substr(0, 10)), InputError);
+}
+
+TEST(Protocol, MeshAndFrameResultLayouts) {
+  TriangleMesh m{Vertices(3, 3), Faces(1, 3)};
+  m.V << 0, 0, 0, 1, 0, 0, 0, 1, 0;
+  m.F << 0, 1, 2;
+  const std::string mesh = encode_mesh_message(m);
+  EXPECT_EQ(mesh.size(), 12u + 36u + 12u);
+  EXPECT_EQ(message_tag(mesh), Tag::Mesh);
+  const std::string frame = encode_frame_result(9, true, {0.001, 0, 0, 0.002, 1e-6, 1e-7}, m.V);
+  EXPECT_EQ(frame.size(), 40u + 36u);
+  float total_ms = 0;
+  std::memcpy(&total_ms, frame.data() + 28, 4);
+  EXPECT_FLOAT_EQ(total_ms, 2.0f);
+  float x1 = 0;
+  std::memcpy(&x1, frame.data() + 40 + 12, 4);
+  EXPECT_EQ(x1, 1.0f);
+  EXPECT_THROW(message_tag("ab"), InputError);
+}
+
+}  // namespace
+}  // namespace specdeform::server
