@@ -30,31 +30,9 @@ double peak_rss_mb() {
   return usage.ru_maxrss / 1024.0;
 }
 
-// The reproducible scene: along the bounding box's longest axis, the handle is every vertex
-// within 5% of the diagonal of the topmost vertex and the lowest 10% of the vertices are fixed;
-// the handle moves by 10% of the diagonal along the second-longest axis.
-struct BenchScene {
-  Selection selection;
-  std::vector<Eigen::Affine3d> transforms;
-};
-
-BenchScene bench_scene(const TriangleMesh& mesh) {
-  const Eigen::Vector3d extent = mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff();
-  int axes[3] = {0, 1, 2};
-  std::sort(axes, axes + 3, [&](int a, int b) { return extent[a] > extent[b]; });
-  Eigen::Index top;
-  mesh.V.col(axes[0]).maxCoeff(&top);
-  BenchScene s;
-  s.selection = radius_selection(mesh, static_cast<int>(top), 0.05, 0.10, axes[0]);
-  Eigen::Vector3d move = Eigen::Vector3d::Zero();
-  move[axes[1]] = 0.1 * extent.norm();
-  s.transforms = {Eigen::Affine3d(Eigen::Translation3d(move))};
-  return s;
-}
-
 nlohmann::ordered_json bench_mesh(const std::string& name, const TriangleMesh& mesh, int modes,
                                   int repeat, const ManifoldHarmonicsOptions& harmonics) {
-  const BenchScene scene = bench_scene(mesh);
+  const Scene scene = benchmark_scene(mesh);
   nlohmann::ordered_json j;
   j["mesh"] = name;
   j["vertices"] = mesh.num_vertices();

@@ -260,6 +260,9 @@ struct EditorServer::Impl {
   awaitable<void> listen() {
     for (;;) {
       tcp::socket socket = co_await acceptor.async_accept(use_awaitable);
+      // Small frame messages go out at once, not held back for an acknowledgement (Nagle).
+      boost::system::error_code ignored;
+      socket.set_option(tcp::no_delay(true), ignored);
       net::co_spawn(io, serve_http(std::move(socket)), net::detached);
     }
   }

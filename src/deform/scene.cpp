@@ -205,6 +205,20 @@ Selection radius_selection(const TriangleMesh& mesh, int center, double radius,
   return s;
 }
 
+Scene benchmark_scene(const TriangleMesh& mesh) {
+  const Eigen::Vector3d extent = mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff();
+  int axes[3] = {0, 1, 2};
+  std::sort(axes, axes + 3, [&](int a, int b) { return extent[a] > extent[b]; });
+  Eigen::Index top;
+  mesh.V.col(axes[0]).maxCoeff(&top);
+  Scene s;
+  s.selection = radius_selection(mesh, static_cast<int>(top), 0.05, 0.10, axes[0]);
+  Eigen::Vector3d move = Eigen::Vector3d::Zero();
+  move[axes[1]] = 0.1 * extent.norm();
+  s.transforms = {Eigen::Affine3d(Eigen::Translation3d(move))};
+  return s;
+}
+
 Selection to_mesh_numbering(const Selection& selection, const MeshReadInfo& info) {
   std::vector<int> index(info.file_vertices.rows(), -1);
   for (size_t i = 0; i < info.vertex_to_file.size(); ++i) index[info.vertex_to_file[i]] = int(i);

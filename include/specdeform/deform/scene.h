@@ -73,6 +73,11 @@ std::vector<Eigen::Affine3d> match_transforms(const Selection& selection,
 Selection radius_selection(const TriangleMesh& mesh, int center, double radius,
                            double fixed_fraction, int up);
 
+// The benchmarks' scene for any mesh: along the bounding box's longest axis, the handle is the
+// radius_selection() of 5% of the diagonal around the topmost vertex, the lowest 10% of the
+// vertices are fixed, and the handle moves by 10% of the diagonal along the second-longest axis.
+Scene benchmark_scene(const TriangleMesh& mesh);
+
 // From file vertex indices to the loaded mesh's; vertices the reader dropped are left out.
 Selection to_mesh_numbering(const Selection& selection, const MeshReadInfo& info);
 

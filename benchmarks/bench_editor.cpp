@@ -1,0 +1,200 @@
+// End-to-end throughput of the editor's server, as the browser sees it minus drawing: a
+// WebSocket client (Boost.Beast) sends a selection, then drags the handle with a stream of
+// frame messages, and times each frame from sending it to receiving its deformed mesh.
+//
+//   bench_editor [MESH] [--seconds S] [--hz H] [--hand V] [--modes M]
+//
+// MESH defaults to ../shared/meshes/models/armadillo.obj (the built-in bumpy bar without it).
+// Scene: benchmark_scene() (scene.h), or with --hand V the vertices within 5% of the diagonal
+// of vertex V as the handle and the lowest 10% along y fixed. Two runs, printed as one JSON
+// object:
+//  - "mouse": frames sent at H per second (default 60, a mouse) for S seconds (default 4): the
+//    results per second that come back and the latency of each (median, 90th percentile);
+//  - "closed_loop": the next frame sent as soon as the previous result arrives: the most
+//    updates per second the server and the connection can carry.
+#include <utility>  // before Boost.Asio, whose awaitable.hpp uses std::exchange
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <thread>
+
+#include <boost/asio.hpp>
+#include <boost/beast.hpp>
+#include <nlohmann/json.hpp>
+
+#include "editor_server.h"
+#include "protocol.h"
+#include "specdeform/deform/scene.h"
+#include "specdeform/mesh/generate.h"
+
+namespace sd = specdeform;
+namespace net = boost::asio;
+namespace beast = boost::beast;
+namespace websocket = beast::websocket;
+using tcp = net::ip::tcp;
+using Clock = std::chrono::steady_clock;
+using Ws = websocket::stream<beast::tcp_stream>;
+
+namespace {
+
+double ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<size_t>(p * v.size()))];
+}
+
+struct Drag {
+  Eigen::Vector3d move;  // where the handle ends up
+  int frames;
+  std::string frame(int k) const {
+    const double s = static_cast<double>(k) / frames;
+    return sd::server::encode_frame(
+        {static_cast<uint32_t>(k), {Eigen::Affine3d(Eigen::Translation3d(s * move))}});
+  }
+};
+
+// Reads until a frame result; returns its seq and the server's solve time (ms).
+net::awaitable<std::pair<uint32_t, float>> next_result(Ws& ws) {
+  for (;;) {
+    beast::flat_buffer buffer;
+    co_await ws.async_read(buffer, net::use_awaitable);
+    const std::string m = beast::buffers_to_string(buffer.data());
+    if (!ws.got_binary()) {
+      if (m.find("\"error\"") != std::string::npos) throw std::runtime_error(m);
+      continue;
+    }
+    if (sd::server::message_tag(m) != sd::server::Tag::FrameResult) continue;
+    uint32_t seq;
+    float total;
+    std::memcpy(&seq, m.data() + 4, 4);
+    std::memcpy(&total, m.data() + 28, 4);
+    co_return std::pair{seq, total};
+  }
+}
+
+net::awaitable<void> run_client(uint16_t port, sd::Selection selection, Drag drag, double hz,
+                                nlohmann::ordered_json& out) {
+  auto ex = co_await net::this_coro::executor;
+  Ws ws(ex);
+  co_await beast::get_lowest_layer(ws).async_connect(
+      tcp::endpoint(net::ip::make_address("127.0.0.1"), port), net::use_awaitable);
+  beast::get_lowest_layer(ws).socket().set_option(tcp::no_delay(true));
+  const std::string host = "127.0.0.1:" + std::to_string(port);
+  ws.set_option(websocket::stream_base::decorator([host](websocket::request_type& req) {
+    req.set(beast::http::field::origin, "http://" + host);
+  }));
+  co_await ws.async_handshake(host, "/ws", net::use_awaitable);
+  ws.binary(true);
+  co_await ws.async_write(
+      net::buffer(sd::server::encode_selection(selection, sd::server::Tag::Selection)),
+      net::use_awaitable);
+
+  // A mouse: frames at a fixed rate, results read as they come.
+  std::map<uint32_t, Clock::time_point> sent;
+  std::vector<double> latency, solve;
+  bool sending = true;
+  const Clock::time_point start = Clock::now();
+  net::co_spawn(
+      ex,
+      [&]() -> net::awaitable<void> {
+        net::steady_timer timer(ex);
+        for (int k = 1; k <= drag.frames; ++k) {
+          timer.expires_at(start + std::chrono::microseconds(static_cast<long>(1e6 * k / hz)));
+          co_await timer.async_wait(net::use_awaitable);
+          sent[k] = Clock::now();
+          co_await ws.async_write(net::buffer(drag.frame(k)), net::use_awaitable);
+        }
+        sending = false;
+      },
+      net::detached);
+  int results = 0;
+  uint32_t last = 0;
+  while (sending || last < static_cast<uint32_t>(drag.frames)) {
+    const auto [seq, total] = co_await next_result(ws);
+    latency.push_back(ms(Clock::now() - sent.at(seq)));
+    solve.push_back(total);
+    last = seq;
+    ++results;
+  }
+  const double seconds = ms(Clock::now() - start) / 1e3;
+  out["mouse"] = {{"frames_sent", drag.frames},
+                  {"hz", hz},
+                  {"results", results},
+                  {"results_per_second", results / seconds},
+                  {"latency_ms_median", percentile(latency, 0.5)},
+                  {"latency_ms_p90", percentile(latency, 0.9)},
+                  {"server_solve_ms_median", percentile(solve, 0.5)}};
+
+  // Closed loop: the next frame as soon as the previous one is back.
+  std::vector<double> round_trip;
+  const Clock::time_point loop_start = Clock::now();
+  for (int k = 1; k <= drag.frames; ++k) {
+    const Clock::time_point t = Clock::now();
+    co_await ws.async_write(net::buffer(drag.frame(drag.frames - k)), net::use_awaitable);
+    co_await next_result(ws);
+    round_trip.push_back(ms(Clock::now() - t));
+  }
+  out["closed_loop"] = {{"frames", drag.frames},
+                        {"updates_per_second", drag.frames / (ms(Clock::now() - loop_start) / 1e3)},
+                        {"round_trip_ms_median", percentile(round_trip, 0.5)}};
+  co_await ws.async_close(websocket::close_code::normal, net::use_awaitable);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::filesystem::path mesh_path =
+      std::filesystem::path(SPECDEFORM_SHARED_DIR) / "meshes/models/armadillo.obj";
+  double seconds = 4, hz = 60;
+  int hand = -1, modes = 100;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const auto value = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string("0"); };
+    if (a == "--seconds") seconds = std::stod(value());
+    else if (a == "--hz") hz = std::stod(value());
+    else if (a == "--hand") hand = std::stoi(value());
+    else if (a == "--modes") modes = std::stoi(value());
+    else mesh_path = a;
+  }
+  try {
+    sd::LoadedMesh mesh;
+    std::string name = "bumpy-bar.obj";
+    if (std::filesystem::exists(mesh_path)) {
+      mesh = sd::read_mesh(mesh_path);
+      name = mesh_path.filename().string();
+    } else {
+      mesh.mesh = sd::make_bumpy_bar();
+      mesh.info = sd::identity_read_info(mesh.mesh);
+    }
+    sd::Scene scene = sd::benchmark_scene(mesh.mesh);
+    if (hand >= 0) scene.selection = sd::radius_selection(mesh.mesh, hand, 0.05, 0.10, 1);
+    nlohmann::ordered_json out;
+    out["mesh"] = name;
+    out["vertices"] = mesh.mesh.num_vertices();
+    out["modes"] = modes;
+    out["handle_vertices"] = scene.selection.handles[0].size();
+    out["fixed_vertices"] = scene.selection.fixed.size();
+    sd::server::EditorServer server({.port = 0, .assets = SPECDEFORM_WEB_DIST},
+                                    {.modes = modes});
+    server.session().open(std::move(mesh), name);
+    std::thread serving([&] { server.run(); });
+    const Drag drag{scene.transforms[0].translation(), static_cast<int>(seconds * hz)};
+    net::io_context io;
+    std::exception_ptr failure;
+    net::co_spawn(io, run_client(server.port(), scene.selection, drag, hz, out),
+                  [&](std::exception_ptr e) { failure = e; });
+    io.run();
+    server.stop();
+    serving.join();
+    if (failure) std::rethrow_exception(failure);
+    std::cout << out.dump(1) << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "bench_editor: " << e.what() << "\n";
+    return 1;
+  }
+}
