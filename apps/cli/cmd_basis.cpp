@@ -59,8 +59,8 @@ void add_basis_command(CLI::App& app) {
       if (!args->output.empty() && converged) std::cout << "wrote " << args->output << "\n";
     }
     if (!converged) {
-      throw SolverError("manifold harmonics did not converge (residual " +
-                        std::to_string(h.max_residual) + ")");
+      throw SolverError("manifold harmonics did not converge: " +
+                        residual_summary(h, args->options.tolerance));
     }
   });
 }

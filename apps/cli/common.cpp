@@ -174,9 +174,8 @@ ManifoldHarmonics obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonics
   o.progress = progress_bar("manifold harmonics");
   ManifoldHarmonics h = compute_manifold_harmonics(mesh, o);
   if (h.status != SolveStatus::Converged) {
-    throw SolverError("manifold harmonics did not converge (residual " +
-                      std::to_string(h.max_residual) + ", asked for " +
-                      std::to_string(options.tolerance) + ")");
+    throw SolverError("manifold harmonics did not converge: " +
+                      residual_summary(h, options.tolerance));
   }
   if (h.cluster_truncated) {
     std::cerr << "note: m = " << options.num_modes

@@ -30,6 +30,10 @@ double seconds_since(Clock::time_point t) {
 
 constexpr const char* kDetailNames[] = {"none", "displacement", "frames", "transfer"};
 
+// The largest basis residual (eigen_residual) the editor works with, warning, when the solver
+// falls short of its tolerance.
+constexpr double kUsableResidual = 1e-6;
+
 DetailMethod detail_from_name(const std::string& name) {
   for (int i = 0; i < 4; ++i) {
     if (name == kDetailNames[i]) return static_cast<DetailMethod>(i);
@@ -57,6 +61,7 @@ struct EditorSession::State {
   ManifoldHarmonics basis;
   double basis_seconds = 0.0;
   bool basis_from_cache = false;
+  std::string warning;  // about the basis, shown to the user
   std::optional<SpectralDeformer> deformer;
   Selection selection;
   bool has_handles = false;
@@ -255,6 +260,7 @@ void EditorSession::build(LoadedMesh mesh, std::string name, const ManifoldHarmo
     s.basis = *reuse_basis;
     s.basis_seconds = state_->basis_seconds;
     s.basis_from_cache = state_->basis_from_cache;
+    s.warning = state_->warning;
   } else if (!cache.empty() && std::filesystem::exists(cache)) {
     report(0.0, "loading the basis");
     s.basis = load_basis(cache, mesh.mesh);
@@ -265,10 +271,15 @@ void EditorSession::build(LoadedMesh mesh, std::string name, const ManifoldHarmo
     o.progress = report;
     s.basis = compute_manifold_harmonics(mesh.mesh, o);
     if (s.basis.status != SolveStatus::Converged) {
-      throw SolverError(name + ": the manifold harmonics did not converge (residual " +
-                        std::to_string(s.basis.max_residual) + ")");
-    }
-    if (!cache.empty()) {
+      // Short of the tolerance but far below what a deformation can show (nearly degenerate
+      // triangles limit the attainable accuracy): usable, with a warning; not cached.
+      if (!(s.basis.max_residual <= kUsableResidual)) {
+        throw SolverError(name + ": the manifold harmonics did not converge: " +
+                          residual_summary(s.basis, o.tolerance));
+      }
+      s.warning = "the basis is less accurate than asked: " +
+                  residual_summary(s.basis, o.tolerance);
+    } else if (!cache.empty()) {
       try {
         std::filesystem::create_directories(cache.parent_path());
         save_basis(cache, s.basis, mesh.mesh, BasisPrecision::Float64);
@@ -322,7 +333,8 @@ void EditorSession::send_state() {
                 {"basis",
                  {{"seconds", s.basis_seconds},
                   {"source", s.basis_from_cache ? "cache" : "computed"},
-                  {"residual", s.basis.max_residual}}},
+                  {"residual", s.basis.max_residual},
+               {"warning", s.warning}}},
                 {"setup",
                  {{"reduced_system", t.reduced_system},
                   {"detail_factorization", t.detail_factorization},

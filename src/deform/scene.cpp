@@ -358,6 +358,47 @@ Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertice
     }
     return s.handles[group];
   };
+  const double diagonal =
+      n > 0 ? (file_vertices.colwise().maxCoeff() - file_vertices.colwise().minCoeff()).norm()
+            : 0.0;
+  // {"vertex": v, "radius": r}: the vertices within r bounding-box diagonals of vertex v.
+  const auto around = [&](const Json& spec, const std::string& w) {
+    const int center = get<int>(spec, "vertex", w);
+    const double radius = get<double>(spec, "radius", w);
+    if (center < 0 || center >= n) throw InputError(w + ": vertex out of range");
+    if (!(radius > 0)) throw InputError(w + ": radius must be > 0");
+    std::vector<int> out;
+    for (int i = 0; i < n; ++i) {
+      if ((file_vertices.row(i) - file_vertices.row(center)).norm() <= radius * diagonal) {
+        out.push_back(i);
+      }
+    }
+    return out;
+  };
+  // {"lowest": f, "axis": "y"}: the fraction f of the vertices lowest along the axis, handles
+  // excepted.
+  const auto lowest = [&](const Json& spec, const std::string& w, const Selection& handles) {
+    const double fraction = get<double>(spec, "lowest", w);
+    const std::string axis = spec.value("axis", "y");
+    if (!(fraction > 0 && fraction < 1)) throw InputError(w + ": lowest is a fraction in (0, 1)");
+    if (axis != "x" && axis != "y" && axis != "z") throw InputError(w + ": axis is x, y or z");
+    const int k = axis[0] - 'x';
+    std::vector<char> is_handle(n, 0);
+    for (const auto& g : handles.handles) {
+      for (int v : g) is_handle[v] = 1;
+    }
+    std::vector<int> order(n);
+    std::iota(order.begin(), order.end(), 0);
+    const int count = static_cast<int>(fraction * n);
+    std::nth_element(order.begin(), order.begin() + count, order.end(),
+                     [&](int a, int b) { return file_vertices(a, k) < file_vertices(b, k); });
+    std::vector<int> out;
+    for (int i = 0; i < count; ++i) {
+      if (!is_handle[order[i]]) out.push_back(order[i]);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  };
   if (!j.contains("handles") || !j["handles"].is_array() || j["handles"].empty()) {
     throw InputError(where + ": the scene has no handles");
   }
@@ -365,8 +406,9 @@ Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertice
     const Json& h = j["handles"][g];
     const std::string w = where + " handle " + std::to_string(g);
     if (!h.is_object()) throw InputError(w + ": a handle is an object");
-    std::vector<int> vertices =
-        h.contains("vertices") ? vertex_list(h["vertices"], w) : from_file(h, w, false);
+    std::vector<int> vertices = h.contains("vertices") ? vertex_list(h["vertices"], w)
+                                : h.contains("around") ? around(h["around"], w)
+                                                       : from_file(h, w, false);
     if (vertices.empty()) throw InputError(w + ": no vertices");
     scene.transforms.push_back(h.contains("transform")
                                    ? parse_transform(h["transform"], vertices, file_vertices, w)
@@ -375,8 +417,9 @@ Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertice
   }
   if (j.contains("fixed")) {
     const Json& f = j["fixed"];
-    scene.selection.fixed =
-        f.is_array() ? vertex_list(f, where + " fixed") : from_file(f, where + " fixed", true);
+    scene.selection.fixed = f.is_array()           ? vertex_list(f, where + " fixed")
+                            : f.contains("lowest") ? lowest(f, where + " fixed", scene.selection)
+                                                   : from_file(f, where + " fixed", true);
   }
   if (j.contains("settings")) {
     const Json& s = j["settings"];

@@ -98,6 +98,45 @@ TEST_F(SceneFiles, JsonScene) {
   EXPECT_EQ(s.options.constraints, ConstraintMode::Hard);
 }
 
+TEST_F(SceneFiles, RegionsByRadiusAndHeight) {
+  Vertices V(5, 3);  // bounding-box diagonal 5
+  V << 0, 0, 0, 0, 1, 0, 0, 2, 0, 0, 3, 0, 0, 4, 3;
+  const Scene s = read_scene(write("r.json", R"({
+    "handles": [{"around": {"vertex": 4, "radius": 0.3}}],
+    "fixed": {"lowest": 0.6, "axis": "y"}
+  })"),
+                             V);
+  EXPECT_EQ(s.selection.handles[0], (std::vector<int>{4}));  // within 1.5 of vertex 4
+  EXPECT_EQ(s.selection.fixed, (std::vector<int>{0, 1, 2}));
+  const Scene t = read_scene(write("t.json", R"({
+    "handles": [{"around": {"vertex": 0, "radius": 0.25}}], "fixed": {"lowest": 0.6}})"),
+                             V);
+  EXPECT_EQ(t.selection.handles[0], (std::vector<int>{0, 1}));
+  EXPECT_EQ(t.selection.fixed, (std::vector<int>{2}));  // handles excepted
+}
+
+TEST_F(SceneFiles, EncodedScenesReadBack) {
+  Vertices V = Eigen::MatrixX3d::Random(6, 3);
+  Scene s;
+  s.mesh = "m.obj";
+  s.selection = {{{1, 2}, {5}}, {0, 3}};
+  s.transforms = {Eigen::Affine3d(Eigen::Translation3d(0.5, 0, 0)) *
+                  Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized())};
+  s.modes = 77;
+  s.options.detail = DetailMethod::Displacement;
+  s.options.ks = 0.25;
+  const Scene back = read_scene(write("e.json", encode_scene(s)), V);
+  EXPECT_EQ(back.mesh, dir_ / "m.obj");
+  EXPECT_EQ(back.selection.handles, s.selection.handles);
+  EXPECT_EQ(back.selection.fixed, s.selection.fixed);
+  ASSERT_EQ(back.transforms.size(), 2u);  // the second group got the identity
+  EXPECT_TRUE(back.transforms[0].matrix().isApprox(s.transforms[0].matrix(), 1e-15));
+  EXPECT_TRUE(back.transforms[1].matrix().isIdentity());
+  EXPECT_EQ(back.modes, 77);
+  EXPECT_EQ(back.options.detail, DetailMethod::Displacement);
+  EXPECT_EQ(back.options.ks, 0.25);
+}
+
 TEST(Scene, SharedBenchmarkScenes) {
   const auto shared = test::shared_dir();
   if (shared.empty()) GTEST_SKIP() << "../shared is absent";

@@ -92,7 +92,7 @@ function onText(m: any): void {
       $<HTMLInputElement>('show-base').checked = m.settings.view === 'base';
       basisInfo = `${m.basis.seconds.toFixed(2)} s (${m.basis.source}, m = ${m.modes})`;
       ready = true;
-      say('');
+      say(m.basis.warning, true);
       updateTimings();
       break;
     case 'selection':

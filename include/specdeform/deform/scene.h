@@ -8,14 +8,16 @@
 //    -1 free, k >= 0 handle group k. Groups without a transform in the .def stay put.
 //  - JSON (docs/scene.md):
 //      { "mesh": "bar.off",                        (relative to the scene file; optional)
-//        "handles": [ { "vertices": [1, 2, 3] | "selection": "x.sel" | "selection": "x.dmat",
+//        "handles": [ { "vertices": [1, 2, 3] | "selection": "x.sel" | "selection": "x.dmat" |
+//                         "around": { "vertex": v, "radius": r },  (r: of the bbox diagonal)
 //                       "group": 0,                 (for a .dmat; 2 = handle for a .sel)
 //                       "transform": [[4 x 4 rows]] |
 //                         { "translate": [x, y, z],
 //                           "rotate": { "axis": [x, y, z], "degrees": a },
 //                           "scale": s,
 //                           "center": [x, y, z] | "centroid" } } ],   (default: centroid)
-//        "fixed": [4, 5] | { "selection": "x.sel" },  (status 0 of a .sel)
+//        "fixed": [4, 5] | { "selection": "x.sel" }   (status 0 of a .sel)
+//                 | { "lowest": f, "axis": "y" },     (fraction f lowest, handles excepted)
 //        "settings": { "modes": 100, "ks": 0, "kb": 1, "constraint_weight": 1e5,
 //                      "constraints": "soft", "detail": "transfer", "solver": "spectral" } }
 //    The transform of a handle maps p to center + R (scale (p - center)) + translate.

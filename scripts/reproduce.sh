@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# Regenerates docs/results/: the paper's Table 1, Fig. 5 and Fig. 6 measured on this machine,
+# and pictures of the pipeline (original, smooth base, deformed base, detailed result).
+# Needs ../shared/meshes (the test meshes) and a build (scripts/setup.sh); installs
+# python3-matplotlib for the plot and chromium for the pictures where missing.
+# Usage: scripts/reproduce.sh [OUT]     (default: docs/results; takes about 15 minutes)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=${1:-docs/results}
+models=../shared/meshes/models
+scenes=../shared/meshes/scenes
+bin=build/bin/specdeform
+[ -d "$models" ] || { echo "reproduce: $models not found (the shared test meshes)" >&2; exit 1; }
+[ -x "$bin" ] || { echo "reproduce: $bin not found (run scripts/setup.sh)" >&2; exit 1; }
+missing=()
+for p in python3-matplotlib chromium; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  sudo_cmd=""
+  [ "$(id -u)" != 0 ] && sudo_cmd="sudo"
+  $sudo_cmd apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
+mkdir -p "$out/pictures"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+arm=$models/armadillo.obj
+hand=docs/results/scenes/armadillo-hand.json
+
+echo "== machine"
+{ lscpu | grep -E "^Model name|^CPU\(s\)"; free -g | grep Mem; git rev-parse --short HEAD; } \
+  | tee "$out/machine.txt"
+
+echo "== Table 1"
+$bin bench "$models/lion.off" "$models/stanford-bunny.obj" "$arm" \
+  --json "$out/table1.json" --markdown "$out/table1.md"
+$bin bench "$arm" --subdivide 1 2 --json "$out/table1_subdivided.json" \
+  --markdown "$out/table1_subdivided.md"
+
+echo "== Fig. 5: time against m"
+$bin bench "$arm" -m 50 100 200 300 500 1000 --json "$out/fig5.json" --markdown "$out/fig5.md"
+/usr/bin/python3 scripts/plot_fig5.py "$out/fig5.json" "$out/fig5.svg"
+
+echo "== Fig. 6: results against m"
+$bin converge "$arm" --scene "$hand" -m 50 100 200 300 500 900 -o "$work/fig6" \
+  --json "$out/fig6.json" --markdown "$out/fig6.md"
+$bin converge "$scenes/bar-bend.off" --sel "$scenes/bar-bend.sel" --def "$scenes/bar-bend.def" \
+  -m 50 100 200 300 500 900 --json "$out/fig6_bar_bend.json" --markdown "$out/fig6_bar_bend.md"
+
+echo "== the pipeline (paper Fig. 1)"
+pipeline() {  # pipeline NAME MESH SCENE-ARGS...
+  local name=$1 mesh=$2
+  shift 2
+  cp "$mesh" "$work/${name}_1_original.${mesh##*.}"
+  $bin smooth "$mesh" -m 100 -o "$work/${name}_2_smooth.obj"
+  $bin deform "$mesh" "$@" -m 100 --detail none -o "$work/${name}_3_deformed_base.obj"
+  $bin deform "$mesh" "$@" -m 100 --detail transfer -o "$work/${name}_4_deformed.obj"
+}
+pipeline armadillo "$arm" --scene "$hand"
+pipeline bar_bend "$scenes/bar-bend.off" --sel "$scenes/bar-bend.sel" --def "$scenes/bar-bend.def"
+
+echo "== pictures"
+jobs="["
+for f in "$work"/armadillo_* "$work"/fig6/m*_deformed.obj; do
+  base=$(basename "$f"); base=${base%.*}
+  case $base in *smooth_deformed) continue ;; esac
+  [ "$base" = "${base#m}" ] || base=armadillo_fig6_$base
+  jobs+="{\"mesh\": \"$f\", \"png\": \"$out/pictures/$base.png\", \"view\": [0, 0.15, 1]},"
+done
+for f in "$work"/bar_bend_*; do
+  base=$(basename "$f"); base=${base%.*}
+  jobs+="{\"mesh\": \"$f\", \"png\": \"$out/pictures/$base.png\", \"view\": [0.2, 0.5, 1]},"
+done
+echo "${jobs%,}]" >"$work/jobs.json"
+node web/e2e/render.mjs "$work/jobs.json"
+echo "reproduce: wrote $out"

@@ -1,0 +1,60 @@
+// Renders meshes to PNG with the editor in headless Chromium (for docs/results.md).
+//
+//   node e2e/render.mjs JOBS.json
+//
+// JOBS.json: [{"mesh": "a.obj", "png": "a.png", "view": [x, y, z], "zoom": 1.3}, ...]: each
+// mesh is opened in the editor (`specdeform edit`) through its file input, looked at from the
+// direction `view` (towards the mesh's centre), and the view is saved without the side panel.
+import { spawn } from 'node:child_process';
+import { readFileSync } from 'node:fs';
+import { basename, dirname, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const jobs = JSON.parse(readFileSync(process.argv[2], 'utf8'));
+const binary = process.env.SPECDEFORM ?? resolve(here, '../../build/bin/specdeform');
+const server = spawn(binary, ['edit', '--port', '0', '--no-cache', '-m', '5', jobs[0].mesh], {
+  stdio: ['ignore', 'pipe', 'inherit'],
+});
+const url = await new Promise((ok, fail) => {
+  server.stdout.on('data', (d) => {
+    const m = /http:\/\/\S+/.exec(String(d));
+    if (m) ok(m[0]);
+  });
+  server.on('exit', (code) => fail(new Error(`specdeform edit exited with ${code}`)));
+});
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+  args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox'],
+});
+try {
+  const page = await browser.newPage({ viewport: { width: 900, height: 900 } });
+  await page.goto(url);
+  await page.addStyleTag({ content: '#panel { display: none !important; }' });
+  await page.waitForFunction(() => window.specdeformEditor?.ready, null, { timeout: 300000 });
+  for (const job of jobs) {
+    const name = basename(job.mesh);
+    await page.setInputFiles('#open-mesh', job.mesh);
+    // The mesh is open when its name shows; an error line instead ends the run.
+    const outcome = await page.waitForFunction(
+      (n) => {
+        const error = document.querySelector('#message:not(.info)')?.textContent;
+        if (error) return { error };
+        const shown = document.querySelector('#mesh-name').textContent.startsWith(`${n}:`);
+        return window.specdeformEditor.ready && shown ? { ok: true } : null;
+      },
+      name,
+      { timeout: 300000 },
+    );
+    const { error } = await outcome.jsonValue();
+    if (error) throw new Error(`${job.mesh}: ${error}`);
+    await page.evaluate(([v, z]) => window.specdeformEditor.setView(v, z), [job.view ?? [0.25, 0.35, 1], job.zoom ?? 1]);
+    await page.waitForTimeout(300);
+    await page.locator('#view').screenshot({ path: job.png });
+    console.log(`rendered ${job.png}`);
+  }
+} finally {
+  await browser.close();
+  server.kill();
+}
