@@ -14,7 +14,8 @@ import { chromium } from 'playwright-core';
 const here = dirname(fileURLToPath(import.meta.url));
 const jobs = JSON.parse(readFileSync(process.argv[2], 'utf8'));
 const binary = process.env.SPECDEFORM ?? resolve(here, '../../build/bin/specdeform');
-const server = spawn(binary, ['edit', '--port', '0', '--no-cache', '-m', '5', jobs[0].mesh], {
+// Starts on the built-in model, so that every job is an upload the page waits for.
+const server = spawn(binary, ['edit', '--port', '0', '--no-cache', '-m', '5'], {
   stdio: ['ignore', 'pipe', 'inherit'],
 });
 const url = await new Promise((ok, fail) => {
@@ -42,7 +43,8 @@ try {
         const error = document.querySelector('#message:not(.info)')?.textContent;
         if (error) return { error };
         const shown = document.querySelector('#mesh-name').textContent.startsWith(`${n}:`);
-        return window.specdeformEditor.ready && shown ? { ok: true } : null;
+        const idle = document.querySelector('#progress').hidden;
+        return window.specdeformEditor.ready && shown && idle ? { ok: true } : null;
       },
       name,
       { timeout: 300000 },
