@@ -22,6 +22,12 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 # The editor's npm packages, pinned by web/package-lock.json; reinstalled when the lock changes.
+# Vite 8 needs Node.js 20.19 or later.
+if ! node -e 'const [a, b] = process.versions.node.split(".").map(Number);
+              process.exit(a > 20 || (a === 20 && b >= 19) ? 0 : 1)'; then
+  echo "setup: Node.js $(node --version) is too old for the editor's build (20.19 or later)" >&2
+  exit 1
+fi
 if [ ! web/node_modules/.package-lock.json -nt web/package-lock.json ]; then
   (cd web && npm ci --no-audit --no-fund --loglevel=error)
 fi

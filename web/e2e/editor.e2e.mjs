@@ -1,6 +1,7 @@
 // End-to-end test of the browser editor in real Chromium (Debian's chromium, driven by
 // playwright-core): start `specdeform edit`, paint a handle and a fixed region with the brush,
-// drag the handle with the mouse, and check what the server sent back and what was drawn.
+// drag the handle with the mouse, and check what the server sent back and what was drawn; then
+// export the mesh, undo and redo, change the detail method, and open another mesh.
 //
 //   node e2e/editor.e2e.mjs [--mesh FILE] [--seconds S] [--out DIR]
 //
@@ -8,8 +9,8 @@
 // 60 mouse events per second; the test prints one JSON line with the updates per second and the
 // drag response (mouse event to frame drawn, median and 90th percentile), and writes
 // editor.png to --out (default: e2e-output).
-import { spawn } from 'node:child_process';
-import { mkdirSync, writeFileSync } from 'node:fs';
+import { execFileSync, spawn } from 'node:child_process';
+import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { parseArgs } from 'node:util';
@@ -171,9 +172,46 @@ try {
     return { fraction: differing / (d.length / 4), shades: shades.size };
   });
   check(drawn.fraction > 0.03 && drawn.shades > 8, `the canvas shows the model (${JSON.stringify(drawn)})`);
-  check(pageErrors.length === 0, `no page errors: ${pageErrors.join('; ')}`);
   mkdirSync(args.out, { recursive: true });
   await page.screenshot({ path: resolve(args.out, 'editor.png') });
+
+  // Export: the downloaded OBJ holds what is shown.
+  await page.selectOption('#export-format', 'obj');
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#export-mesh')]);
+  const exported = readFileSync(await download.path(), 'utf8').split('\n').filter((l) => l.startsWith('v '));
+  check(exported.length === ends.n, `the export has ${exported.length} of ${ends.n} vertices`);
+  const exportError = Math.max(...exported.map((l, v) =>
+    Math.max(...l.split(/\s+/).slice(1, 4).map((x, k) => Math.abs(Number(x) - state.now[3 * v + k])))));
+  check(exportError < 1e-5 * state.diagonal, `the export matches the view (${exportError})`);
+
+  // Undo puts the handle back (the rest shape), redo moves it again.
+  const restError = async () => {
+    await page.waitForFunction(() => window.specdeformEditor.settled(), null, { timeout: 30000 });
+    return page.evaluate(() => {
+      const e = window.specdeformEditor;
+      const [p, r] = [e.positions(), e.restPositions()];
+      return Math.max(...p.map((x, i) => Math.abs(x - r[i]))) / e.diagonal();
+    });
+  };
+  await page.evaluate(() => document.activeElement?.blur()); // shortcuts skip focused inputs
+  await page.keyboard.press('Control+z');
+  check((await restError()) < 1e-5, 'undo returns to the rest shape');
+  await page.keyboard.press('Control+Shift+z');
+  check((await restError()) > 0.02, 'redo deforms it again');
+
+  // A detail method from the panel: the server rebuilds and the frame comes back solved with it.
+  await page.selectOption('#detail', 'displacement');
+  await page.waitForFunction(() => document.querySelector('#detail').value === 'displacement' &&
+    window.specdeformEditor.ready, null, { timeout: 60000 });
+  check((await restError()) > 0.02, 'the deformation survives a settings change');
+
+  // Another mesh through the file picker.
+  const sphere = resolve(args.out, 'sphere.off');
+  execFileSync(args.binary, ['generate', 'icosphere', '--subdivisions', '2', '-o', sphere]);
+  await page.setInputFiles('#open-mesh', sphere);
+  await page.waitForFunction(() => document.querySelector('#mesh-name').textContent.startsWith('sphere.off: 162 vertices'),
+    null, { timeout: 60000 });
+  check(pageErrors.length === 0, `no page errors: ${pageErrors.join('; ')}`);
 
   const latencies = state.stats.latencies.slice(before.latencies, after.latencies);
   const receive = state.stats.receiveLatencies.slice(before.receive, after.receive);

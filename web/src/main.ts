@@ -101,6 +101,7 @@ function onText(m: any): void {
       break;
     case 'error':
       $('progress').hidden = true;
+      ready = rest.length > 0; // a failed change leaves the previous state in place
       say(m.message);
       break;
   }
@@ -153,13 +154,12 @@ viewer.onRendered = () => {
 function adoptMesh(m: P.MeshMessage): void {
   const same = m.indices.length === indices.length && m.indices.every((v, i) => v === indices[i]) &&
     m.positions.every((v, i) => v === rest[i]);
+  // The same mesh again (a settings change rebuilt the server's solver): keep the view, the
+  // selection and the shown frame.
+  if (same) return;
   rest = m.positions.slice();
   indices = m.indices.slice();
   viewer.setMesh(rest, indices);
-  if (same) {
-    paint();
-    return;
-  }
   brush = new Brush(rest.length / 3, indices);
   labels = new Int16Array(rest.length / 3);
   transforms = [new THREE.Matrix4()];
@@ -182,8 +182,12 @@ function restore(s: Snapshot): void {
   sendSelection();
 }
 
+// Records the state after a change; a gesture that changed nothing adds no undo step.
 function commit(): void {
-  history.push(snapshot());
+  const last = history.current();
+  const same = last && last.transforms.length === transforms.length &&
+    last.transforms.every((t, g) => t.equals(transforms[g])) && last.labels.every((l, v) => l === labels[v]);
+  if (!same) history.push(snapshot());
 }
 
 function selection(): P.Selection {
@@ -400,13 +404,17 @@ setInterval(updateTimings, 500);
 
 async function openFile(file: File, tag: number): Promise<void> {
   say(`sending ${file.name}…`, true);
+  if (tag === P.Tag.MeshFile) ready = false;
   send(P.encodeFile(tag, file.name, await file.arrayBuffer()));
 }
 
 document.querySelectorAll<HTMLButtonElement>('[data-tool]').forEach((b) =>
   b.addEventListener('click', () => setTool(b.dataset.tool as Tool)),
 );
-$('open-demo').addEventListener('click', () => send({ type: 'open_demo' }));
+$('open-demo').addEventListener('click', () => {
+  ready = false;
+  send({ type: 'open_demo' });
+});
 $<HTMLInputElement>('open-mesh').addEventListener('change', (e) => {
   const f = (e.target as HTMLInputElement).files?.[0];
   if (f) openFile(f, P.Tag.MeshFile);
@@ -421,14 +429,19 @@ $('wireframe').addEventListener('change', (e) => viewer.setWireframe((e.target a
 $('show-base').addEventListener('change', (e) =>
   send({ type: 'settings', view: (e.target as HTMLInputElement).checked ? 'base' : 'detailed' }),
 );
+// Solver settings rebuild the server's deformer: busy until its "ready".
+function sendSettings(settings: object): void {
+  ready = false;
+  send({ type: 'settings', ...settings });
+}
 for (const id of ['modes', 'ks', 'kb']) {
   $(id).addEventListener('change', (e) => {
     const v = Number((e.target as HTMLInputElement).value);
-    if (Number.isFinite(v)) send({ type: 'settings', [id]: v });
+    if (Number.isFinite(v)) sendSettings({ [id]: v });
   });
 }
 for (const id of ['detail', 'constraints']) {
-  $(id).addEventListener('change', (e) => send({ type: 'settings', [id]: (e.target as HTMLSelectElement).value }));
+  $(id).addEventListener('change', (e) => sendSettings({ [id]: (e.target as HTMLSelectElement).value }));
 }
 $('group').addEventListener('change', (e) => {
   activeGroup = Number((e.target as HTMLSelectElement).value);
