@@ -36,14 +36,24 @@ CLI::Validator number_check(bool allow_zero) {
 const CLI::Validator kPositive = number_check(false);
 const CLI::Validator kNonNegative = number_check(true);
 
-const std::map<std::string, DetailMethod> kDetailNames{{"none", DetailMethod::None},
-                                                       {"displacement", DetailMethod::Displacement},
-                                                       {"frames", DetailMethod::Frames},
-                                                       {"transfer", DetailMethod::Transfer}};
-const std::map<std::string, DeformSolver> kSolverNames{{"spectral", DeformSolver::Spectral},
-                                                       {"spatial", DeformSolver::Spatial}};
-const std::map<std::string, ConstraintMode> kConstraintNames{{"soft", ConstraintMode::Soft},
-                                                             {"hard", ConstraintMode::Hard}};
+namespace {
+
+// Name -> mode, the names from the library (deform_options.h).
+template <typename Mode>
+std::map<std::string, Mode> by_name(std::initializer_list<Mode> modes) {
+  std::map<std::string, Mode> out;
+  for (Mode m : modes) out.emplace(name(m), m);
+  return out;
+}
+
+}  // namespace
+
+const std::map<std::string, DetailMethod> kDetailNames = by_name(
+    {DetailMethod::None, DetailMethod::Displacement, DetailMethod::Frames, DetailMethod::Transfer});
+const std::map<std::string, DeformSolver> kSolverNames =
+    by_name({DeformSolver::Spectral, DeformSolver::Spatial});
+const std::map<std::string, ConstraintMode> kConstraintNames =
+    by_name({ConstraintMode::Soft, ConstraintMode::Hard});
 
 LoadedMesh load_mesh(const std::string& path) {
   LoadedMesh loaded = read_mesh(path);

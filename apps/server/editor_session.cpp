@@ -28,18 +28,9 @@ double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-constexpr const char* kDetailNames[] = {"none", "displacement", "frames", "transfer"};
-
 // The largest basis residual (eigen_residual) the editor works with, warning, when the solver
 // falls short of its tolerance.
 constexpr double kUsableResidual = 1e-6;
-
-DetailMethod detail_from_name(const std::string& name) {
-  for (int i = 0; i < 4; ++i) {
-    if (name == kDetailNames[i]) return static_cast<DetailMethod>(i);
-  }
-  throw InputError("settings: unknown detail method '" + name + "'");
-}
 
 std::filesystem::path cache_file(const std::filesystem::path& dir, const TriangleMesh& mesh,
                                  int modes, MassType mass) {
@@ -165,11 +156,8 @@ void EditorSession::text_message(std::string_view message) {
     if (auto v = number("ks", 0, 1e6)) o.ks = *v;
     if (auto v = number("kb", 0, 1e6)) o.kb = *v;
     if (!(o.ks > 0 || o.kb > 0)) throw InputError("settings: ks and kb cannot both be 0");
-    if (auto v = word("detail")) o.detail = detail_from_name(*v);
-    if (auto v = word("constraints")) {
-      if (*v != "soft" && *v != "hard") throw InputError("settings: constraints are soft or hard");
-      o.constraints = *v == "soft" ? ConstraintMode::Soft : ConstraintMode::Hard;
-    }
+    if (auto v = word("detail")) o.detail = detail_method_from_name(*v);
+    if (auto v = word("constraints")) o.constraints = constraint_mode_from_name(*v);
     if (auto v = word("view")) {
       if (*v != "detailed" && *v != "base") throw InputError("settings: view is detailed or base");
       base_view = *v == "base";
@@ -277,8 +265,8 @@ void EditorSession::build(LoadedMesh mesh, std::string name, const ManifoldHarmo
         throw SolverError(name + ": the manifold harmonics did not converge: " +
                           residual_summary(s.basis, o.tolerance));
       }
-      s.warning = "the basis is less accurate than asked: " +
-                  residual_summary(s.basis, o.tolerance);
+      s.warning =
+          "the basis is less accurate than asked: " + residual_summary(s.basis, o.tolerance);
     } else if (!cache.empty()) {
       try {
         std::filesystem::create_directories(cache.parent_path());
@@ -295,7 +283,7 @@ void EditorSession::build(LoadedMesh mesh, std::string name, const ManifoldHarmo
   s.name = std::move(name);
   s.result = s.loaded.mesh.V;
   const Vertices& V = s.loaded.mesh.V;
-  s.diagonal = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
+  s.diagonal = bounding_box_diagonal(V);
   // Settings changes reopen the same mesh: keep the selection and the handles' transforms.
   if (state_ && state_->loaded.mesh.V.rows() == V.rows() &&
       state_->loaded.mesh.F == s.loaded.mesh.F && state_->loaded.mesh.V == V) {
@@ -316,29 +304,27 @@ void EditorSession::send_state() {
   State& s = *state_;
   send_(true, encode_mesh_message(s.loaded.mesh));
   const SetupTimings& t = s.deformer->setup_timings();
-  send_(
-      false,
-      dump(Json{{"type", "ready"},
-                {"name", s.name},
-                {"vertices", s.loaded.mesh.num_vertices()},
-                {"faces", s.loaded.mesh.num_faces()},
-                {"diagonal", s.diagonal},
-                {"modes", s.modes},
-                {"settings",
-                 {{"ks", s.options.ks},
-                  {"kb", s.options.kb},
-                  {"detail", kDetailNames[static_cast<int>(s.options.detail)]},
-                  {"constraints", s.options.constraints == ConstraintMode::Soft ? "soft" : "hard"},
-                  {"view", s.base_view ? "base" : "detailed"}}},
-                {"basis",
-                 {{"seconds", s.basis_seconds},
-                  {"source", s.basis_from_cache ? "cache" : "computed"},
-                  {"residual", s.basis.max_residual},
-               {"warning", s.warning}}},
-                {"setup",
-                 {{"reduced_system", t.reduced_system},
-                  {"detail_factorization", t.detail_factorization},
-                  {"selection", t.selection}}}}));
+  send_(false, dump(Json{{"type", "ready"},
+                         {"name", s.name},
+                         {"vertices", s.loaded.mesh.num_vertices()},
+                         {"faces", s.loaded.mesh.num_faces()},
+                         {"diagonal", s.diagonal},
+                         {"modes", s.modes},
+                         {"settings",
+                          {{"ks", s.options.ks},
+                           {"kb", s.options.kb},
+                           {"detail", name(s.options.detail)},
+                           {"constraints", name(s.options.constraints)},
+                           {"view", s.base_view ? "base" : "detailed"}}},
+                         {"basis",
+                          {{"seconds", s.basis_seconds},
+                           {"source", s.basis_from_cache ? "cache" : "computed"},
+                           {"residual", s.basis.max_residual},
+                           {"warning", s.warning}}},
+                         {"setup",
+                          {{"reduced_system", t.reduced_system},
+                           {"detail_factorization", t.detail_factorization},
+                           {"selection", t.selection}}}}));
   if (s.has_handles) solve_and_send();
 }
 

@@ -82,6 +82,36 @@ Eigen::Affine3d checked_transform(const Eigen::Matrix4d& m, const std::string& w
   return Eigen::Affine3d(m);
 }
 
+// The vertices within `radius` (absolute) of vertex `center`, ascending.
+std::vector<int> vertices_within(const Vertices& V, int center, double radius) {
+  std::vector<int> out;
+  for (int i = 0; i < V.rows(); ++i) {
+    if ((V.row(i) - V.row(center)).norm() <= radius) out.push_back(i);
+  }
+  return out;
+}
+
+// The `fraction` of the vertices lowest along `axis`, minus those in `excluded`, ascending.
+std::vector<int> lowest_vertices(const Vertices& V, double fraction, int axis,
+                                 const std::vector<std::vector<int>>& excluded) {
+  const int n = static_cast<int>(V.rows());
+  std::vector<char> skip(n, 0);
+  for (const auto& group : excluded) {
+    for (int v : group) skip[v] = 1;
+  }
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  const int count = static_cast<int>(fraction * n);
+  std::nth_element(order.begin(), order.begin() + count, order.end(),
+                   [&](int a, int b) { return V(a, axis) < V(b, axis); });
+  std::vector<int> out;
+  for (int k = 0; k < count; ++k) {
+    if (!skip[order[k]]) out.push_back(order[k]);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 }  // namespace
 
 Selection parse_sel(std::string_view text, int file_vertices, std::string_view name) {
@@ -184,24 +214,9 @@ Selection radius_selection(const TriangleMesh& mesh, int center, double radius,
       !(fixed_fraction >= 0 && fixed_fraction < 1)) {
     throw InputError("radius selection: bad centre vertex, axis or fraction");
   }
-  const double r = radius * bounding_box_diagonal(mesh.V);
   Selection s;
-  s.handles.resize(1);
-  std::vector<char> in_handle(n, 0);
-  for (int i = 0; i < n; ++i) {
-    if ((mesh.V.row(i) - mesh.V.row(center)).norm() <= r) {
-      s.handles[0].push_back(i);
-      in_handle[i] = 1;
-    }
-  }
-  std::vector<int> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  const int count = static_cast<int>(fixed_fraction * n);
-  std::nth_element(order.begin(), order.begin() + count, order.end(),
-                   [&](int a, int b) { return mesh.V(a, up) < mesh.V(b, up); });
-  for (int k = 0; k < count; ++k)
-    if (!in_handle[order[k]]) s.fixed.push_back(order[k]);
-  std::sort(s.fixed.begin(), s.fixed.end());
+  s.handles = {vertices_within(mesh.V, center, radius * bounding_box_diagonal(mesh.V))};
+  s.fixed = lowest_vertices(mesh.V, fixed_fraction, up, s.handles);
   return s;
 }
 
@@ -358,22 +373,13 @@ Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertice
     }
     return s.handles[group];
   };
-  const double diagonal =
-      n > 0 ? (file_vertices.colwise().maxCoeff() - file_vertices.colwise().minCoeff()).norm()
-            : 0.0;
   // {"vertex": v, "radius": r}: the vertices within r bounding-box diagonals of vertex v.
   const auto around = [&](const Json& spec, const std::string& w) {
     const int center = get<int>(spec, "vertex", w);
     const double radius = get<double>(spec, "radius", w);
     if (center < 0 || center >= n) throw InputError(w + ": vertex out of range");
     if (!(radius > 0)) throw InputError(w + ": radius must be > 0");
-    std::vector<int> out;
-    for (int i = 0; i < n; ++i) {
-      if ((file_vertices.row(i) - file_vertices.row(center)).norm() <= radius * diagonal) {
-        out.push_back(i);
-      }
-    }
-    return out;
+    return vertices_within(file_vertices, center, radius * bounding_box_diagonal(file_vertices));
   };
   // {"lowest": f, "axis": "y"}: the fraction f of the vertices lowest along the axis, handles
   // excepted.
@@ -382,22 +388,7 @@ Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertice
     const std::string axis = spec.value("axis", "y");
     if (!(fraction > 0 && fraction < 1)) throw InputError(w + ": lowest is a fraction in (0, 1)");
     if (axis != "x" && axis != "y" && axis != "z") throw InputError(w + ": axis is x, y or z");
-    const int k = axis[0] - 'x';
-    std::vector<char> is_handle(n, 0);
-    for (const auto& g : handles.handles) {
-      for (int v : g) is_handle[v] = 1;
-    }
-    std::vector<int> order(n);
-    std::iota(order.begin(), order.end(), 0);
-    const int count = static_cast<int>(fraction * n);
-    std::nth_element(order.begin(), order.begin() + count, order.end(),
-                     [&](int a, int b) { return file_vertices(a, k) < file_vertices(b, k); });
-    std::vector<int> out;
-    for (int i = 0; i < count; ++i) {
-      if (!is_handle[order[i]]) out.push_back(order[i]);
-    }
-    std::sort(out.begin(), out.end());
-    return out;
+    return lowest_vertices(file_vertices, fraction, axis[0] - 'x', handles.handles);
   };
   if (!j.contains("handles") || !j["handles"].is_array() || j["handles"].empty()) {
     throw InputError(where + ": the scene has no handles");
@@ -430,24 +421,17 @@ Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertice
     if (s.contains("kb")) o.kb = get<double>(s, "kb", w);
     if (s.contains("constraint_weight"))
       o.constraint_weight = get<double>(s, "constraint_weight", w);
-    const auto choose = [&](const char* key, auto& out, const auto& names) {
+    const auto choose = [&](const char* key, auto& out, auto from_name) {
       if (!s.contains(key)) return;
-      const std::string v = get<std::string>(s, key, w);
-      const auto it = names.find(v);
-      if (it == names.end()) throw InputError(w + ": unknown " + key + " '" + v + "'");
-      out = it->second;
+      try {
+        out = from_name(get<std::string>(s, key, w));
+      } catch (const InputError& e) {
+        throw InputError(w + ": " + e.what());
+      }
     };
-    choose("constraints", o.constraints,
-           std::map<std::string, ConstraintMode>{{"soft", ConstraintMode::Soft},
-                                                 {"hard", ConstraintMode::Hard}});
-    choose("detail", o.detail,
-           std::map<std::string, DetailMethod>{{"none", DetailMethod::None},
-                                               {"displacement", DetailMethod::Displacement},
-                                               {"frames", DetailMethod::Frames},
-                                               {"transfer", DetailMethod::Transfer}});
-    choose("solver", o.solver,
-           std::map<std::string, DeformSolver>{{"spectral", DeformSolver::Spectral},
-                                               {"spatial", DeformSolver::Spatial}});
+    choose("constraints", o.constraints, constraint_mode_from_name);
+    choose("detail", o.detail, detail_method_from_name);
+    choose("solver", o.solver, deform_solver_from_name);
   }
   return scene;
 }
@@ -468,10 +452,9 @@ std::string encode_scene(const Scene& scene) {
   const DeformOptions& o = scene.options;
   Json settings = {{"ks", o.ks}, {"kb", o.kb}, {"constraint_weight", o.constraint_weight}};
   if (scene.modes) settings["modes"] = *scene.modes;
-  settings["constraints"] = o.constraints == ConstraintMode::Soft ? "soft" : "hard";
-  settings["solver"] = o.solver == DeformSolver::Spectral ? "spectral" : "spatial";
-  constexpr const char* kDetail[] = {"none", "displacement", "frames", "transfer"};
-  settings["detail"] = kDetail[static_cast<int>(o.detail)];
+  settings["constraints"] = name(o.constraints);
+  settings["solver"] = name(o.solver);
+  settings["detail"] = name(o.detail);
   j["settings"] = settings;
   return j.dump(1) + "\n";
 }

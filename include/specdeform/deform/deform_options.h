@@ -10,6 +10,8 @@
 // a_i the vertex's lumped area on the same unit-area scale (so w does not depend on resolution).
 #pragma once
 
+#include <string_view>
+
 namespace specdeform {
 
 enum class ConstraintMode {
@@ -38,5 +40,14 @@ struct DeformOptions {
   DetailMethod detail = DetailMethod::Transfer;
   bool float32_basis = false;  // keep the basis in single precision (faster frames)
 };
+
+// The modes' names in scene files, on the command line and in the editor ("soft", "spatial",
+// "transfer", ...). The *_from_name functions throw InputError for an unknown name.
+std::string_view name(ConstraintMode mode);
+std::string_view name(DeformSolver solver);
+std::string_view name(DetailMethod method);
+ConstraintMode constraint_mode_from_name(std::string_view name);
+DeformSolver deform_solver_from_name(std::string_view name);
+DetailMethod detail_method_from_name(std::string_view name);
 
 }  // namespace specdeform
