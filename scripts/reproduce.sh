@@ -12,16 +12,7 @@ scenes=../shared/meshes/scenes
 bin=build/bin/specdeform
 [ -d "$models" ] || { echo "reproduce: $models not found (the shared test meshes)" >&2; exit 1; }
 [ -x "$bin" ] || { echo "reproduce: $bin not found (run scripts/setup.sh)" >&2; exit 1; }
-missing=()
-for p in python3-matplotlib chromium; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  sudo_cmd=""
-  [ "$(id -u)" != 0 ] && sudo_cmd="sudo"
-  $sudo_cmd apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${missing[@]}" >/dev/null
-fi
+scripts/apt_install.sh python3-matplotlib chromium
 mkdir -p "$out/pictures"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

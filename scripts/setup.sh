@@ -10,17 +10,7 @@ packages=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libo
           libspectra-dev libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev libboost-dev
           libcgal-dev)
 command -v npm >/dev/null || packages+=(nodejs npm)
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  sudo_cmd=""
-  [ "$(id -u)" != 0 ] && sudo_cmd="sudo"
-  echo "installing: ${missing[*]}"
-  $sudo_cmd apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${missing[@]}" >/dev/null
-fi
+scripts/apt_install.sh "${packages[@]}"
 
 # The editor's npm packages, pinned by web/package-lock.json; reinstalled when the lock changes.
 # Vite 8 needs Node.js 20.19 or later.

@@ -9,12 +9,12 @@
 // 60 mouse events per second; the test prints one JSON line with the updates per second and the
 // drag response (mouse event to frame drawn, median and 90th percentile), and writes
 // editor.png to --out (default: e2e-output).
-import { execFileSync, spawn } from 'node:child_process';
+import { execFileSync } from 'node:child_process';
 import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { parseArgs } from 'node:util';
-import { chromium } from 'playwright-core';
+import { launchChromium, startEditor } from './harness.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const { values: args } = parseArgs({
@@ -31,29 +31,13 @@ function check(condition, message) {
   if (!condition) throw new Error(`check failed: ${message}`);
 }
 
-function startServer() {
-  const argv = ['edit', '--port', '0', '--no-cache', ...(args.mesh ? [args.mesh] : [])];
-  const server = spawn(args.binary, argv, { stdio: ['ignore', 'pipe', 'inherit'] });
-  const url = new Promise((resolveUrl, reject) => {
-    server.stdout.on('data', (d) => {
-      const m = /http:\/\/\S+/.exec(String(d));
-      if (m) resolveUrl(m[0]);
-    });
-    server.on('exit', (code) => reject(new Error(`specdeform edit exited with ${code}`)));
-  });
-  return { server, url };
-}
-
 const percentile = (values, p) => {
   const s = [...values].sort((a, b) => a - b);
   return s[Math.min(s.length - 1, Math.floor(p * s.length))];
 };
 
-const { server, url } = startServer();
-const browser = await chromium.launch({
-  executablePath: args.chromium,
-  args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox'],
-});
+const { server, url } = startEditor(args.binary, args.mesh ? [args.mesh] : []);
+const browser = await launchChromium(args.chromium);
 try {
   const page = await browser.newPage({ viewport: { width: 1200, height: 760 } });
   const pageErrors = [];

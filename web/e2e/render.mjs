@@ -5,33 +5,20 @@
 // JOBS.json: [{"mesh": "a.obj", "png": "a.png", "view": [x, y, z], "zoom": 1.3}, ...]: each
 // mesh is opened in the editor (`specdeform edit`) through its file input, looked at from the
 // direction `view` (towards the mesh's centre), and the view is saved without the side panel.
-import { spawn } from 'node:child_process';
 import { readFileSync } from 'node:fs';
 import { basename, dirname, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { chromium } from 'playwright-core';
+import { launchChromium, startEditor } from './harness.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const jobs = JSON.parse(readFileSync(process.argv[2], 'utf8'));
 const binary = process.env.SPECDEFORM ?? resolve(here, '../../build/bin/specdeform');
 // Starts on the built-in model, so that every job is an upload the page waits for.
-const server = spawn(binary, ['edit', '--port', '0', '--no-cache', '-m', '5'], {
-  stdio: ['ignore', 'pipe', 'inherit'],
-});
-const url = await new Promise((ok, fail) => {
-  server.stdout.on('data', (d) => {
-    const m = /http:\/\/\S+/.exec(String(d));
-    if (m) ok(m[0]);
-  });
-  server.on('exit', (code) => fail(new Error(`specdeform edit exited with ${code}`)));
-});
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-  args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox'],
-});
+const { server, url } = startEditor(binary, ['-m', '5']);
+const browser = await launchChromium();
 try {
   const page = await browser.newPage({ viewport: { width: 900, height: 900 } });
-  await page.goto(url);
+  await page.goto(await url);
   await page.addStyleTag({ content: '#panel { display: none !important; }' });
   await page.waitForFunction(() => window.specdeformEditor?.ready, null, { timeout: 300000 });
   for (const job of jobs) {

@@ -1,0 +1,26 @@
+// What the editor's browser scripts share: starting `specdeform edit` and headless Chromium.
+import { spawn } from 'node:child_process';
+import { chromium } from 'playwright-core';
+
+// Starts `BINARY edit --port 0 --no-cache ARGS...`; `url` resolves to the address it prints.
+export function startEditor(binary, editArgs = []) {
+  const server = spawn(binary, ['edit', '--port', '0', '--no-cache', ...editArgs], {
+    stdio: ['ignore', 'pipe', 'inherit'],
+  });
+  const url = new Promise((resolveUrl, reject) => {
+    server.stdout.on('data', (d) => {
+      const m = /http:\/\/\S+/.exec(String(d));
+      if (m) resolveUrl(m[0]);
+    });
+    server.on('exit', (code) => reject(new Error(`specdeform edit exited with ${code}`)));
+  });
+  return { server, url };
+}
+
+// Debian's Chromium (or `executablePath`), drawing WebGL with SwiftShader where there is no GPU.
+export function launchChromium(executablePath = process.env.CHROMIUM ?? '/usr/bin/chromium') {
+  return chromium.launch({
+    executablePath,
+    args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox'],
+  });
+}
