@@ -1,9 +1,9 @@
 #include "protocol.h"
 
 #include <bit>
-#include <cmath>
 #include <cstring>
 
+#include "specdeform/deform/scene.h"
 #include "specdeform/exceptions.h"
 
 static_assert(std::endian::native == std::endian::little, "the protocol is little-endian");
@@ -112,14 +112,7 @@ FrameRequest decode_frame(std::string_view message, int num_groups) {
   for (uint32_t g = 0; g < groups; ++g) {
     Eigen::Matrix4d m;
     for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = r.get<double>();
-    const std::string which = "transform " + std::to_string(g);
-    if (!m.allFinite()) r.fail(which + " is not finite");
-    if (m.row(3) != Eigen::RowVector4d(0, 0, 0, 1)) r.fail(which + " is not affine");
-    const Eigen::Matrix3d a = m.topLeftCorner<3, 3>();
-    if (!(std::abs(a.determinant()) > 1e-12 * std::pow(a.norm(), 3))) {
-      r.fail(which + " is not invertible");
-    }
-    f.transforms.emplace_back(m);
+    f.transforms.push_back(checked_transform(m, "frame message: transform " + std::to_string(g)));
   }
   return f;
 }

@@ -71,7 +71,7 @@ Tag message_tag(std::string_view message);
 // Throws InputError for a wrong length, too many groups, or an index out of [0, n).
 Selection decode_selection(std::string_view message, int num_vertices);
 // Throws InputError for a wrong length, a group count other than `num_groups`, or a transform
-// that is not finite, not affine (last row 0 0 0 1) or not invertible.
+// checked_transform() (scene.h) refuses.
 FrameRequest decode_frame(std::string_view message, int num_groups);
 // Throws InputError for a wrong length or a name that is empty, too long or not printable.
 NamedFile decode_file(std::string_view message);

@@ -70,18 +70,6 @@ void check_count(size_t got, int expected, std::string_view name) {
   }
 }
 
-Eigen::Affine3d checked_transform(const Eigen::Matrix4d& m, const std::string& where) {
-  if (!m.allFinite()) throw InputError(where + ": the transform is not finite");
-  if (m.row(3) != Eigen::RowVector4d(0, 0, 0, 1)) {
-    throw InputError(where + ": the transform's last row must be 0 0 0 1");
-  }
-  const Eigen::Matrix3d linear = m.topLeftCorner<3, 3>();
-  if (!(std::abs(linear.determinant()) > 1e-12 * std::pow(linear.norm(), 3))) {
-    throw InputError(where + ": the transform is not invertible");
-  }
-  return Eigen::Affine3d(m);
-}
-
 // The vertices within `radius` (absolute) of vertex `center`, ascending.
 std::vector<int> vertices_within(const Vertices& V, int center, double radius) {
   std::vector<int> out;
@@ -113,6 +101,18 @@ std::vector<int> lowest_vertices(const Vertices& V, double fraction, int axis,
 }
 
 }  // namespace
+
+Eigen::Affine3d checked_transform(const Eigen::Matrix4d& m, const std::string& where) {
+  if (!m.allFinite()) throw InputError(where + ": the transform is not finite");
+  if (m.row(3) != Eigen::RowVector4d(0, 0, 0, 1)) {
+    throw InputError(where + ": the transform's last row must be 0 0 0 1");
+  }
+  const Eigen::Matrix3d linear = m.topLeftCorner<3, 3>();
+  if (!(std::abs(linear.determinant()) > 1e-12 * std::pow(linear.norm(), 3))) {
+    throw InputError(where + ": the transform is not invertible");
+  }
+  return Eigen::Affine3d(m);
+}
 
 Selection parse_sel(std::string_view text, int file_vertices, std::string_view name) {
   const std::vector<std::string> t = tokens(text, true);

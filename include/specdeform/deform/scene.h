@@ -64,6 +64,10 @@ Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertice
 // settings); read_scene() reads it back to the same selection, transforms and settings.
 std::string encode_scene(const Scene& scene);
 
+// `m` as an affine transform; throws InputError, `where` first, for one that is not finite, not
+// affine (last row 0 0 0 1) or not invertible.
+Eigen::Affine3d checked_transform(const Eigen::Matrix4d& m, const std::string& where);
+
 // Pads `transforms` with identities up to the number of handle groups; throws InputError if
 // there are more transforms than groups or the selection has no handle vertex.
 std::vector<Eigen::Affine3d> match_transforms(const Selection& selection,
