@@ -28,7 +28,6 @@
 #include "editor_server.h"
 #include "protocol.h"
 #include "specdeform/deform/scene.h"
-#include "specdeform/mesh/generate.h"
 
 namespace sd = specdeform;
 namespace net = boost::asio;
@@ -40,7 +39,9 @@ using Ws = websocket::stream<beast::tcp_stream>;
 
 namespace {
 
-double ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
+double ms(Clock::duration d) {
+  return std::chrono::duration<double, std::milli>(d).count();
+}
 
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0.0;
@@ -155,22 +156,21 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto value = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string("0"); };
-    if (a == "--seconds") seconds = std::stod(value());
-    else if (a == "--hz") hz = std::stod(value());
-    else if (a == "--hand") hand = std::stoi(value());
-    else if (a == "--modes") modes = std::stoi(value());
-    else mesh_path = a;
+    if (a == "--seconds")
+      seconds = std::stod(value());
+    else if (a == "--hz")
+      hz = std::stod(value());
+    else if (a == "--hand")
+      hand = std::stoi(value());
+    else if (a == "--modes")
+      modes = std::stoi(value());
+    else
+      mesh_path = a;
   }
   try {
-    sd::LoadedMesh mesh;
-    std::string name = "bumpy-bar.obj";
-    if (std::filesystem::exists(mesh_path)) {
-      mesh = sd::read_mesh(mesh_path);
-      name = mesh_path.filename().string();
-    } else {
-      mesh.mesh = sd::make_bumpy_bar();
-      mesh.info = sd::identity_read_info(mesh.mesh);
-    }
+    const bool found = std::filesystem::exists(mesh_path);
+    sd::LoadedMesh mesh = found ? sd::read_mesh(mesh_path) : sd::server::demo_mesh();
+    const std::string name = found ? mesh_path.filename().string() : sd::server::kDemoName;
     sd::Scene scene = sd::benchmark_scene(mesh.mesh);
     if (hand >= 0) scene.selection = sd::radius_selection(mesh.mesh, hand, 0.05, 0.10, 1);
     nlohmann::ordered_json out;
@@ -179,8 +179,7 @@ int main(int argc, char** argv) {
     out["modes"] = modes;
     out["handle_vertices"] = scene.selection.handles[0].size();
     out["fixed_vertices"] = scene.selection.fixed.size();
-    sd::server::EditorServer server({.port = 0, .assets = SPECDEFORM_WEB_DIST},
-                                    {.modes = modes});
+    sd::server::EditorServer server({.port = 0, .assets = SPECDEFORM_WEB_DIST}, {.modes = modes});
     server.session().open(std::move(mesh), name);
     std::thread serving([&] { server.run(); });
     const Drag drag{scene.transforms[0].translation(), static_cast<int>(seconds * hz)};

@@ -4,7 +4,6 @@
 
 #include "common.h"
 #include "editor_server.h"
-#include "specdeform/mesh/generate.h"
 
 namespace specdeform::cli {
 
@@ -60,15 +59,10 @@ void add_edit_command(CLI::App& app) {
     if (args->no_cache) args->editor.cache_dir.clear();
     args->server.max_message_bytes = static_cast<size_t>(args->max_upload_mb * (1 << 20));
     server::EditorServer editor(args->server, args->editor);
-    LoadedMesh mesh;
-    std::string name = "bumpy-bar.obj";
-    if (args->mesh.empty()) {
-      mesh.mesh = make_bumpy_bar();
-      mesh.info = identity_read_info(mesh.mesh);
-    } else {
-      mesh = load_mesh(args->mesh);
-      name = std::filesystem::path(args->mesh).filename().string();
-    }
+    LoadedMesh mesh = args->mesh.empty() ? server::demo_mesh() : load_mesh(args->mesh);
+    const std::string name = args->mesh.empty()
+                                 ? server::kDemoName
+                                 : std::filesystem::path(args->mesh).filename().string();
     std::cerr << name << ": " << mesh.mesh.num_vertices()
               << " vertices; preparing m = " << args->editor.modes << " manifold harmonics\n";
     editor.session().open(std::move(mesh), name);

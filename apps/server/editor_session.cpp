@@ -61,6 +61,13 @@ struct EditorSession::State {
   Vertices result;  // the last detailed result (the rest positions before any frame)
 };
 
+LoadedMesh demo_mesh() {
+  LoadedMesh demo;
+  demo.mesh = make_bumpy_bar();
+  demo.info = identity_read_info(demo.mesh);
+  return demo;
+}
+
 EditorSession::EditorSession(EditorConfig config, Send send)
     : config_(std::move(config)), send_(std::move(send)) {}
 
@@ -127,10 +134,7 @@ void EditorSession::text_message(std::string_view message) {
   }
   const std::string type = j["type"];
   if (type == "open_demo") {
-    LoadedMesh demo;
-    demo.mesh = make_bumpy_bar();
-    demo.info = identity_read_info(demo.mesh);
-    return open(std::move(demo), "bumpy-bar.obj");
+    return open(demo_mesh(), kDemoName);
   }
   if (!state_) throw InputError("no mesh is open");
   State& s = *state_;

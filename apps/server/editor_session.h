@@ -45,6 +45,10 @@ class Cancelled : public Error {
   Cancelled() : Error("cancelled") {}
 };
 
+// The built-in model the editor opens without a mesh (and on "open_demo"): the bumpy bar.
+inline constexpr const char* kDemoName = "bumpy-bar.obj";
+LoadedMesh demo_mesh();
+
 class EditorSession {
  public:
   // `send(binary, data)` delivers one message to the browser.
