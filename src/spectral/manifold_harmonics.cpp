@@ -367,37 +367,35 @@ Spectrum solve_lanczos(const Sparse& K, const Sparse& M, int m, const ManifoldHa
   return out;
 }
 
-// Residual of each pair on the unit-area scale (see eigen_residual).
-Vec pair_residuals(const Sparse& K, const Sparse& M, const Mat& H, const Vec& lambda) {
-  const double area = M.sum();
-  const Vec d_inv = (M * Vec::Ones(M.rows())).cwiseInverse();
-  Vec out(H.cols());
-  constexpr int kColumns = 64;  // in blocks, to bound the temporaries
-  for (Eigen::Index j = 0; j < H.cols(); j += kColumns) {
-    const Eigen::Index c = std::min<Eigen::Index>(kColumns, H.cols() - j);
-    const Mat R =
-        K * H.middleCols(j, c) - (M * H.middleCols(j, c)) * lambda.segment(j, c).asDiagonal();
-    const Vec r = R.cwiseAbs2().transpose() * d_inv;
-    for (Eigen::Index i = 0; i < c; ++i) {
-      out[j + i] = area * std::sqrt(r[i]) / std::max(area * lambda[j + i], 1.0);
-    }
-  }
-  return out;
-}
+// Each pair's residual on the unit-area scale (see eigen_residual), and its rounding floor: the
+// rounding error of forming K h - lambda M h in the same measure, eps A || |K||h| +
+// |lambda| |M||h| ||_{D^-1} / max(A lambda, 1). No solver gets a residual below its floor; it
+// matters on meshes with nearly degenerate triangles, whose huge cotangent weights and tiny
+// areas put it above the tolerance.
+struct PairErrors {
+  Vec residual, floor;
+};
 
-// The rounding error of forming K h - lambda M h for each pair, in the measure of
-// pair_residuals: no solver gets a pair's residual below it. It matters on meshes with nearly
-// degenerate triangles, whose huge cotangent weights and tiny areas put it above the tolerance.
-Vec rounding_floors(const Sparse& K, const Sparse& M, const Mat& H, const Vec& lambda) {
+PairErrors pair_errors(const Sparse& K, const Sparse& M, const Mat& H, const Vec& lambda) {
   const double area = M.sum();
   const Vec d_inv = (M * Vec::Ones(M.rows())).cwiseInverse();
   const Sparse K_abs = K.cwiseAbs(), M_abs = M.cwiseAbs();
-  Vec out(H.cols());
-  for (Eigen::Index j = 0; j < H.cols(); ++j) {
-    const Vec h = H.col(j).cwiseAbs();
-    const Vec bound = K_abs * h + std::abs(lambda[j]) * (M_abs * h);
-    const double norm = std::sqrt(bound.cwiseAbs2().dot(d_inv));
-    out[j] = std::numeric_limits<double>::epsilon() * area * norm / std::max(area * lambda[j], 1.0);
+  PairErrors out{Vec(H.cols()), Vec(H.cols())};
+  constexpr int kColumns = 64;  // in blocks, to bound the temporaries
+  for (Eigen::Index j = 0; j < H.cols(); j += kColumns) {
+    const Eigen::Index c = std::min<Eigen::Index>(kColumns, H.cols() - j);
+    const auto block = H.middleCols(j, c);
+    const auto l = lambda.segment(j, c);
+    const Mat R = K * block - (M * block) * l.asDiagonal();
+    const Mat abs_block = block.cwiseAbs();
+    const Mat bound = K_abs * abs_block + (M_abs * abs_block) * l.cwiseAbs().asDiagonal();
+    const Vec r = R.cwiseAbs2().transpose() * d_inv;
+    const Vec b = bound.cwiseAbs2().transpose() * d_inv;
+    for (Eigen::Index i = 0; i < c; ++i) {
+      const double scale = area / std::max(area * lambda[j + i], 1.0);
+      out.residual[j + i] = scale * std::sqrt(r[i]);
+      out.floor[j + i] = scale * std::numeric_limits<double>::epsilon() * std::sqrt(b[i]);
+    }
   }
   return out;
 }
@@ -501,8 +499,7 @@ Spectrum solve_block_krylov(const Sparse& K, const Sparse& Mmat, int m,
     rayleigh_ritz(K, M, r.H, r.lambda);
     std::vector<double> seen(1, count > 0 ? last : sigma);
     seen.insert(seen.end(), r.lambda.begin(), r.lambda.end());
-    const Vec residual = pair_residuals(K, Mmat, r.H, r.lambda);
-    const Vec floors = rounding_floors(K, Mmat, r.H, r.lambda);
+    const auto [residual, floors] = pair_errors(K, Mmat, r.H, r.lambda);
     if (sigma > 0.0 && r.converged && !residuals_within(residual, floors, o.tolerance, 10)) {
       // Inaccurate solves broke the Krylov relation (a shift close to an eigenvalue): redo the
       // band with the shift in a gap between the eigenvalues seen.
@@ -542,7 +539,7 @@ Spectrum solve_block_krylov(const Sparse& K, const Sparse& Mmat, int m,
 }  // namespace
 
 double eigen_residual(const Sparse& K, const Sparse& M, const Mat& H, const Vec& lambda) {
-  return H.cols() == 0 ? 0.0 : pair_residuals(K, M, H, lambda).maxCoeff();
+  return H.cols() == 0 ? 0.0 : pair_errors(K, M, H, lambda).residual.maxCoeff();
 }
 
 std::string residual_summary(const ManifoldHarmonics& h, double tolerance) {
@@ -616,8 +613,7 @@ ManifoldHarmonics compute_manifold_harmonics(const Sparse& K, const Sparse& M,
     if (out.basis(i, j) < 0) out.basis.col(j) *= -1.0;
   }
   report(o, 1.0, "verification");
-  const Vec residual = pair_residuals(K, M, out.basis, out.eigenvalues);
-  const Vec floors = rounding_floors(K, M, out.basis, out.eigenvalues);
+  const auto [residual, floors] = pair_errors(K, M, out.basis, out.eigenvalues);
   out.max_residual = residual.maxCoeff();
   out.rounding_floor = floors.maxCoeff();
   out.max_orthogonality_error = orthonormality_error(M, out.basis);
