@@ -176,18 +176,9 @@ void EditorSession::text_message(std::string_view message) {
                               o.constraints != s.options.constraints;
     s.base_view = base_view;
     if (new_deformer) {
-      LoadedMesh mesh = s.loaded;
-      const DeformOptions previous = s.options;
-      const int previous_modes = s.modes;
+      build(s.loaded, s.name, modes, o, new_basis ? nullptr : &s.basis);
+      config_.modes = modes;  // meshes opened later start with these settings too
       config_.options = o;
-      config_.modes = modes;
-      try {
-        build(std::move(mesh), s.name, new_basis ? nullptr : &s.basis);
-      } catch (...) {
-        config_.options = previous;
-        config_.modes = previous_modes;
-        throw;
-      }
       return;
     }
     return solve_and_send();
@@ -223,15 +214,16 @@ void EditorSession::text_message(std::string_view message) {
 }
 
 void EditorSession::open(LoadedMesh mesh, std::string name) {
-  build(std::move(mesh), std::move(name), nullptr);
+  build(std::move(mesh), std::move(name), config_.modes, config_.options, nullptr);
 }
 
-void EditorSession::build(LoadedMesh mesh, std::string name, const ManifoldHarmonics* reuse_basis) {
+void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
+                          const DeformOptions& options, const ManifoldHarmonics* reuse_basis) {
   cancelled_ = false;
   auto next = std::make_unique<State>();
   State& s = *next;
-  s.modes = config_.modes;
-  s.options = config_.options;
+  s.modes = modes;
+  s.options = options;
   const int n = mesh.mesh.num_vertices();
   if (n < 4) throw InputError(name + ": too few vertices to deform");
   if (s.modes >= n) s.modes = n - 1;

@@ -74,7 +74,8 @@ class EditorSession {
   void set_selection(Selection selection);
   void solve_and_send();
   void send_state();
-  void build(LoadedMesh mesh, std::string name, const ManifoldHarmonics* reuse_basis);
+  void build(LoadedMesh mesh, std::string name, int modes, const DeformOptions& options,
+             const ManifoldHarmonics* reuse_basis);
   void send_error(const std::string& message);
 
   EditorConfig config_;
