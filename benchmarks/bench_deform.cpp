@@ -9,6 +9,7 @@
 //   build/bin/bench_deform --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -68,21 +69,29 @@ SpectralDeformer make(const Setup& s, DeformSolver solver, bool float32 = false)
   return SpectralDeformer(s.mesh, s.basis, o);
 }
 
-void report(benchmark::State& state, const Setup& s, const SpectralDeformer& d) {
-  state.counters["n"] = s.mesh.num_vertices();
-  state.counters["constrained"] =
-      static_cast<double>(s.selection.handles[0].size() + s.selection.fixed.size());
-  state.counters["reduced_ms"] = d.frame_timings().reduced_solve * 1e3;
-  state.counters["inverse_ms"] = d.frame_timings().inverse_transform * 1e3;
-  state.counters["detail_ms"] = d.frame_timings().detail * 1e3;
+double median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
 }
 
+// The stages' medians over the iterations, in milliseconds.
 void BM_Frame(benchmark::State& state, DeformSolver solver, bool float32) {
   const Setup& s = setup(static_cast<int>(state.range(0)));
   SpectralDeformer d = make(s, solver, float32);
   d.set_selection(s.selection);
-  for (auto _ : state) benchmark::DoNotOptimize(d.solve(s.move).data());
-  report(state, s, d);
+  std::vector<double> reduced, inverse, detail;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(d.solve(s.move).data());
+    reduced.push_back(d.frame_timings().reduced_solve);
+    inverse.push_back(d.frame_timings().inverse_transform);
+    detail.push_back(d.frame_timings().detail);
+  }
+  state.counters["n"] = s.mesh.num_vertices();
+  state.counters["constrained"] =
+      static_cast<double>(s.selection.handles[0].size() + s.selection.fixed.size());
+  state.counters["reduced_ms"] = median(reduced) * 1e3;
+  state.counters["inverse_ms"] = median(inverse) * 1e3;
+  state.counters["detail_ms"] = median(detail) * 1e3;
 }
 
 void BM_SelectionChange(benchmark::State& state, DeformSolver solver) {

@@ -21,12 +21,19 @@ AnchoredPoisson::AnchoredPoisson(const Sparse& K)
   cholmod_start(common_);
   common_->supernodal = CHOLMOD_SIMPLICIAL;  // rowadd and rowdel work on simplicial LDL^T
   common_->final_ll = 0;
+  common_->nmethods = 1;
+  common_->method[0].ordering = CHOLMOD_METIS;
   Sparse lower = K_.triangularView<Eigen::Lower>();
   cholmod_sparse A = Eigen::viewAsCholmod(lower);
   A.stype = -1;
   factor_ = cholmod_analyze(&A, common_);
+  if (factor_ == nullptr) {  // a CHOLMOD built without METIS: its default orderings
+    common_->nmethods = 0;
+    factor_ = cholmod_analyze(&A, common_);
+  }
   if (factor_ == nullptr) throw SolverError("deformation transfer: Poisson analysis failed");
   const int* perm = static_cast<const int*>(factor_->Perm);
+  order_.assign(perm, perm + K_.rows());
   for (int k = 0; k < static_cast<int>(K_.rows()); ++k) position_[perm[k]] = k;
 }
 
@@ -87,6 +94,7 @@ void AnchoredPoisson::set_anchors(const std::vector<int>& anchors) {
     anchored_ = std::move(next);
     factorize();
     factored_ = true;
+    solver_ = TriangularSolver(factor_, common_);
     return;
   }
   for (const int v : add) {
@@ -97,15 +105,7 @@ void AnchoredPoisson::set_anchors(const std::vector<int>& anchors) {
   if (common_->status != CHOLMOD_OK) {
     throw SolverError("deformation transfer: updating the Poisson factorisation failed");
   }
-}
-
-Eigen::MatrixX3d AnchoredPoisson::solve(const Eigen::MatrixX3d& rhs) const {
-  Eigen::MatrixX3d b = rhs;
-  cholmod_dense B = Eigen::viewAsCholmod(b);
-  cholmod_dense* X = cholmod_solve(CHOLMOD_A, factor_, &B, common_);
-  Eigen::MatrixX3d out = Eigen::Map<Eigen::MatrixX3d>(static_cast<double*>(X->x), rhs.rows(), 3);
-  cholmod_free_dense(&X, common_);
-  return out;
+  solver_ = TriangularSolver(factor_, common_);
 }
 
 }  // namespace specdeform::detail

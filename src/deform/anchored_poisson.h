@@ -1,15 +1,20 @@
 // Internal: the Poisson system of deformation transfer with its anchors, K_anchored x = b, K the
 // cotangent stiffness of the detailed mesh and the anchors' rows and columns made identity.
 //
-// A simplicial LDL^T factorisation (CHOLMOD). When the anchor set changes, newly anchored
+// A simplicial LDL^T factorisation (CHOLMOD) in a nested-dissection ordering (METIS): it keeps
+// neighbours close in memory and splits the work evenly between two threads. When the anchor
+// set changes, newly anchored
 // vertices are removed with cholmod_rowdel and released ones put back with cholmod_rowadd (a
 // rank-2 update each), so a selection change costs in proportion to its difference; a change of
-// more than a quarter of the vertices is refactored from scratch.
+// more than a quarter of the vertices is refactored from scratch. Solves run on two threads
+// (linalg/triangular_solver.h).
 #pragma once
 
 #include <vector>
 
 #include <Eigen/Sparse>
+
+#include "linalg/triangular_solver.h"
 
 struct cholmod_common_struct;
 struct cholmod_factor_struct;
@@ -26,17 +31,23 @@ class AnchoredPoisson {
   // Throws SolverError if the system is singular (a component without anchors).
   void set_anchors(const std::vector<int>& anchors);
 
-  Eigen::MatrixX3d solve(const Eigen::MatrixX3d& rhs) const;
+  // The factor's ordering: its row k is vertex order()[k].
+  const std::vector<int>& order() const { return order_; }
+  // Solves in place, in the factor's ordering: see TriangularSolver::solve_in_place (width 3).
+  int workspace_rows() const { return solver_.workspace_rows(); }
+  void solve_in_place(double* x) const { solver_.solve_in_place(x, 3); }
 
  private:
   void factorize();
   void release(int vertex);
   Eigen::SparseMatrix<double> K_;
   std::vector<char> anchored_;
-  std::vector<int> position_;  // vertex -> its row in the permuted factor
+  std::vector<int> order_;     // the factor's row -> vertex
+  std::vector<int> position_;  // vertex -> its row in the factor
   cholmod_common_struct* common_;
   cholmod_factor_struct* factor_ = nullptr;
   bool factored_ = false;
+  TriangularSolver solver_;
 };
 
 }  // namespace specdeform::detail

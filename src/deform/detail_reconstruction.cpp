@@ -5,7 +5,7 @@
 #include <Eigen/LU>
 
 #include "anchored_poisson.h"
-#include "parallel.h"
+#include "linalg/parallel.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/operators/cotan_laplacian.h"
 
@@ -42,46 +42,69 @@ Eigen::Matrix3d triangle_frame(const Vertices& V, const Faces& F, int f) {
 
 }  // namespace
 
+using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
 struct DetailReconstruction::Poisson {
   // Per triangle f, with B_f = [c - a, b - a, n] of the base and
   // Q_f = A_f [grad phi_a; grad phi_b; grad phi_c] [grad x, grad y, grad z] (corners by
   // coordinates): the Poisson right-hand side of the transferred gradients J_f S_f^T,
   // S_f = B'_f B_f^-1, is the scatter over the corners of Q_f S_f^T = P_f B'_f^T with
-  // P_f = Q_f B_f^-T. Where the base's triangle is degenerate, S_f = I and P_f holds Q_f.
-  std::vector<Eigen::Matrix3d> transfer;  // P_f (or Q_f)
-  std::vector<char> identity;             // 1 where S_f = I
-  Sparse K;                               // cotangent stiffness of the detailed mesh
-  Sparse coupling;                        // n x n': K's columns of the anchors, anchor rows zeroed
-  std::vector<int> anchors;
+  // P_f = Q_f B_f^-T. Where the base's triangle is degenerate, S_f = I and the corners get Q_f.
+  // Gathered per vertex i, the right-hand side is linear in the deformed base s' but for the
+  // unit normals n'_f:
+  //     b_i = constant_i + sum_j edges_ij s'_j + sum_f normal weight_if n'_f.
+  // Everything here is numbered as the Poisson factor (`order`): a nested-dissection ordering
+  // keeps neighbours close in memory, and the right-hand side is assembled where the solve
+  // wants it.
+  Eigen::SparseMatrix<double, Eigen::RowMajor> edges;    // n x n, compressed
+  Eigen::SparseMatrix<double, Eigen::RowMajor> normals;  // n x faces, compressed
+  RowMajor constant;                                     // n x 3
+  Sparse K;                                              // cotangent stiffness of the detailed mesh
+  Sparse coupling;           // n x n': K's columns of the anchors, anchor rows zeroed
+  std::vector<int> anchors;  // the anchors' rows
   std::unique_ptr<detail::AnchoredPoisson> system;
+  std::vector<int> order;  // row k is vertex order[k] of the mesh
+  std::vector<int> rank;   // and vertex i of the mesh is row rank[i]
+  Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> faces;  // sorted by their first row
 };
 
 namespace {
 
-using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
-
-// Adds, for triangles [begin, end), the Poisson right-hand side of the transferred gradients:
-// S_f maps the base's triangle to the deformed one (positions), and the corners' share of the
-// divergence of the transformed detail gradients is Q_f S_f^T (J' = J S^T).
-// Compiled for AVX2 as well, chosen at run time: no -march flag is needed.
-__attribute__((target_clones("avx2", "default"))) void accumulate_divergence(
-    const DetailReconstruction::Poisson& p, const Faces& faces, const RowMajor& positions,
-    int begin, int end, RowMajor& out) {
+// Unit normals (b - a) x (c - a) of the faces [begin, end); zero where degenerate. Positions
+// and normals are row-major n x 3 and faces x 3.
+__attribute__((target_clones("avx2", "default"))) void unit_normals(const int* faces,
+                                                                    const double* positions,
+                                                                    int begin, int end,
+                                                                    double* normals) {
   for (int f = begin; f < end; ++f) {
-    const int a = faces(f, 0), b = faces(f, 1), c = faces(f, 2);
-    Eigen::Matrix3d C = p.transfer[f];
-    if (!p.identity[f]) {
-      Eigen::Matrix3d frame;
-      frame.col(0) = (positions.row(c) - positions.row(a)).transpose();
-      frame.col(1) = (positions.row(b) - positions.row(a)).transpose();
-      const Eigen::Vector3d normal = frame.col(1).cross(frame.col(0));
-      const double length = normal.norm();
-      frame.col(2) = length > 0.0 ? Eigen::Vector3d(normal / length) : Eigen::Vector3d::Zero();
-      C = p.transfer[f] * frame.transpose();
+    const double* a = positions + 3 * faces[3 * f];
+    const double* b = positions + 3 * faces[3 * f + 1];
+    const double* c = positions + 3 * faces[3 * f + 2];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                         u[0] * v[1] - u[1] * v[0]};
+    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const double scale = length > 0.0 ? 1.0 / length : 0.0;
+    for (int d = 0; d < 3; ++d) normals[3 * f + d] = n[d] * scale;
+  }
+}
+
+// out_i += sum_j A_ij x_j for the rows [begin, end) of A (CSR); x and out row-major, 3 columns.
+using RowSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+__attribute__((target_clones("avx2", "default"))) void add_product(const RowSparse& A,
+                                                                   const double* x, int begin,
+                                                                   int end, double* out) {
+  const int* start = A.outerIndexPtr();
+  const int* column = A.innerIndexPtr();
+  const double* value = A.valuePtr();
+  for (int i = begin; i < end; ++i) {
+    double sum[3] = {out[3 * i], out[3 * i + 1], out[3 * i + 2]};
+    for (int e = start[i]; e < start[i + 1]; ++e) {
+      const double* xj = x + 3 * column[e];
+      for (int d = 0; d < 3; ++d) sum[d] += value[e] * xj[d];
     }
-    out.row(a) += C.row(0);
-    out.row(b) += C.row(1);
-    out.row(c) += C.row(2);
+    for (int d = 0; d < 3; ++d) out[3 * i + d] = sum[d];
   }
 }
 
@@ -124,9 +147,30 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
       const Eigen::VectorXd areas = face_areas(detailed);
       const Eigen::MatrixX3d J = G * detailed.V;  // rows 3f..3f+2: gradients of x, y, z
       const int nf = detailed.num_faces();
-      p.transfer.resize(nf);
-      p.identity.resize(nf);
+      const int n = detailed.num_vertices();
+      Eigen::PermutationMatrix<Eigen::Dynamic> to_rows(n);
+      {
+        const Sparse K = cotan_stiffness(detailed);
+        p.system = std::make_unique<detail::AnchoredPoisson>(K);
+        p.order = p.system->order();
+        p.rank.resize(n);
+        for (int k = 0; k < n; ++k) p.rank[p.order[k]] = k;
+        for (int i = 0; i < n; ++i) to_rows.indices()[i] = p.rank[i];
+        p.K = K.twistedBy(to_rows);
+      }
+      std::vector<int> face_order(nf), first(nf);
       for (int f = 0; f < nf; ++f) {
+        face_order[f] = f;
+        first[f] = std::min({p.rank[faces_(f, 0)], p.rank[faces_(f, 1)], p.rank[faces_(f, 2)]});
+      }
+      std::stable_sort(face_order.begin(), face_order.end(),
+                       [&](int a, int b) { return first[a] < first[b]; });
+      p.faces.resize(nf, 3);
+      std::vector<Eigen::Triplet<double>> edges, normals;
+      p.constant = RowMajor::Zero(n, 3);
+      for (int g = 0; g < nf; ++g) {  // face g here is face f of the mesh
+        const int f = face_order[g];
+        for (int k = 0; k < 3; ++k) p.faces(g, k) = p.rank[faces_(f, k)];
         const Eigen::Matrix3d m = triangle_frame(base, faces_, f);
         bool invertible = false;
         Eigen::Matrix3d inv = Eigen::Matrix3d::Zero();
@@ -135,11 +179,24 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
         for (int k = 0; k < 3; ++k)
           for (int d = 0; d < 3; ++d) corners(k, d) = G.coeff(3 * f + d, faces_(f, k));
         const Eigen::Matrix3d Q = areas[f] * corners * J.middleRows<3>(3 * f);
-        p.identity[f] = !(invertible && m.col(2).squaredNorm() > 0);
-        p.transfer[f] = p.identity[f] ? Q : Eigen::Matrix3d(Q * inv.transpose());
+        const int a = p.faces(g, 0), b = p.faces(g, 1), c = p.faces(g, 2);
+        if (!(invertible && m.col(2).squaredNorm() > 0)) {
+          for (int r = 0; r < 3; ++r) p.constant.row(p.faces(g, r)) += Q.row(r);
+          continue;
+        }
+        const Eigen::Matrix3d P = Q * inv.transpose();
+        for (int r = 0; r < 3; ++r) {  // P(r, :) [c' - a', b' - a', n']^T
+          const int v = p.faces(g, r);
+          edges.emplace_back(v, c, P(r, 0));
+          edges.emplace_back(v, b, P(r, 1));
+          edges.emplace_back(v, a, -P(r, 0) - P(r, 1));
+          normals.emplace_back(v, g, P(r, 2));
+        }
       }
-      p.K = cotan_stiffness(detailed);
-      p.system = std::make_unique<detail::AnchoredPoisson>(p.K);
+      p.edges.resize(n, n);
+      p.edges.setFromTriplets(edges.begin(), edges.end());
+      p.normals.resize(n, nf);
+      p.normals.setFromTriplets(normals.begin(), normals.end());
       break;
     }
   }
@@ -152,13 +209,14 @@ DetailReconstruction& DetailReconstruction::operator=(DetailReconstruction&&) no
 void DetailReconstruction::set_anchors(const std::vector<int>& vertices) {
   if (method_ != DetailMethod::Transfer) return;
   Poisson& p = *poisson_;
-  p.anchors = vertices;
+  p.anchors.resize(vertices.size());
+  for (size_t i = 0; i < vertices.size(); ++i) p.anchors[i] = p.rank[vertices[i]];
   std::vector<char> anchored(p.K.rows(), 0);
-  for (const int v : vertices) anchored[v] = 1;
+  for (const int v : p.anchors) anchored[v] = 1;
   p.system->set_anchors(vertices);
   std::vector<Eigen::Triplet<double>> coupling;
-  for (size_t i = 0; i < vertices.size(); ++i) {
-    for (Sparse::InnerIterator it(p.K, vertices[i]); it; ++it) {
+  for (size_t i = 0; i < p.anchors.size(); ++i) {
+    for (Sparse::InnerIterator it(p.K, p.anchors[i]); it; ++it) {
       if (!anchored[it.row()]) coupling.emplace_back(it.row(), static_cast<int>(i), it.value());
     }
   }
@@ -191,18 +249,27 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
   if (anchors.rows() != static_cast<Eigen::Index>(p.anchors.size())) {
     throw InputError("deformation transfer: anchor positions do not match the anchors");
   }
-  const RowMajor positions = s;  // contiguous rows for the per-triangle gathers
-  // Two halves of the triangles on two threads, each into its own buffer.
-  const int nf = static_cast<int>(faces_.rows());
-  RowMajor halves[2] = {RowMajor::Zero(s.rows(), 3), RowMajor::Zero(s.rows(), 3)};
-  detail::split_in_two(nf, [&](Eigen::Index begin, Eigen::Index end) {
-    accumulate_divergence(p, faces_, positions, static_cast<int>(begin), static_cast<int>(end),
-                          halves[begin == 0 ? 0 : 1]);
+  const int n = static_cast<int>(s.rows());
+  RowMajor positions(n, 3);
+  for (int k = 0; k < n; ++k) positions.row(k) = s.row(p.order[k]);
+  RowMajor normals(faces_.rows(), 3);
+  detail::split_in_two(faces_.rows(), [&](Eigen::Index begin, Eigen::Index end) {
+    unit_normals(p.faces.data(), positions.data(), begin, end, normals.data());
   });
-  Eigen::MatrixX3d rhs = halves[0] + halves[1];
-  rhs -= p.coupling * anchors;
-  for (size_t i = 0; i < p.anchors.size(); ++i) rhs.row(p.anchors[i]) = anchors.row(i);
-  return p.system->solve(rhs);
+  RowMajor x(p.system->workspace_rows(), 3);  // the right-hand side, then the solution
+  detail::split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
+    x.middleRows(begin, end - begin) = p.constant.middleRows(begin, end - begin);
+    add_product(p.edges, positions.data(), begin, end, x.data());
+    add_product(p.normals, normals.data(), begin, end, x.data());
+  });
+  for (int i = 0; i < p.coupling.outerSize(); ++i)
+    for (Sparse::InnerIterator it(p.coupling, i); it; ++it)
+      x.row(it.row()) -= it.value() * anchors.row(i);
+  for (size_t i = 0; i < p.anchors.size(); ++i) x.row(p.anchors[i]) = anchors.row(i);
+  p.system->solve_in_place(x.data());
+  Vertices out(n, 3);
+  for (int k = 0; k < n; ++k) out.row(p.order[k]) = x.row(k);
+  return out;
 }
 
 }  // namespace specdeform

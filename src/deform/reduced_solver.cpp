@@ -25,7 +25,7 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
   if (options_.constraints == ConstraintMode::Soft) {
     Eigen::VectorXd w(nc);
     for (int i = 0; i < nc; ++i) w[i] = options_.constraint_weight * vertex_area_[vertices[i]];
-    weighted_rows_ = w.asDiagonal() * rows_;
+    weighted_columns_ = (w.asDiagonal() * rows_).transpose();
     // Update the normal matrix by the vertices that changed, or rebuild it when many did.
     std::vector<char> next(basis_.rows(), 0);
     for (const int v : vertices) next[v] = 1;
@@ -37,7 +37,7 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
       }
     }
     if (constrained_.empty() || 2 * (added.size() + removed.size()) > vertices.size()) {
-      normal_ = rows_.transpose() * weighted_rows_;
+      normal_ = weighted_columns_ * rows_;
       normal_.diagonal() += hessian_;
     } else {
       const auto update = [&](const std::vector<int>& changed, double sign) {
@@ -96,10 +96,18 @@ Eigen::MatrixX3d ReducedSolver::solve(const Eigen::MatrixX3d& targets) const {
     throw InputError("deformation: targets for " + std::to_string(targets.rows()) +
                      " vertices, the selection has " + std::to_string(rows_.rows()));
   }
+  // Outer products and vector solves: no BLAS call, whose worker threads would spin on the
+  // second core while the rest of the frame needs it. Vertices that keep their place (the
+  // fixed ones, typically most) add nothing to the right-hand side.
   if (options_.constraints == ConstraintMode::Soft) {
-    return soft_.solve(weighted_rows_.transpose() * targets);
+    Eigen::MatrixX3d c = Eigen::MatrixX3d::Zero(weighted_columns_.rows(), 3);
+    for (Eigen::Index i = 0; i < targets.rows(); ++i) {
+      if (!targets.row(i).isZero(0.0)) c.noalias() += weighted_columns_.col(i) * targets.row(i);
+    }
+    for (int d = 0; d < 3; ++d) c.col(d) = soft_.solve(c.col(d));
+    return c;
   }
-  return hard_ * targets;
+  return hard_.lazyProduct(targets);
 }
 
 }  // namespace specdeform

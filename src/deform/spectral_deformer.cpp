@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "linalg/basis_product.h"
 #include "specdeform/deform/reduced_solver.h"
 #include "specdeform/deform/spatial_solver.h"
 #include "specdeform/exceptions.h"
@@ -99,11 +100,11 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
   if (reduced_) {
     const Eigen::MatrixX3d c = reduced_->solve(displacement_targets);
     frame_.reduced_solve = clock.lap();
+    deformed_base_ = base_;
     if (options_.float32_basis) {
-      deformed_base_ = base_ + (basis32_ * c.cast<float>()).cast<double>();
+      detail::add_basis_product(basis32_, c, deformed_base_);
     } else {
-      deformed_base_.noalias() = basis_.basis * c;
-      deformed_base_ += base_;
+      detail::add_basis_product(basis_.basis, c, deformed_base_);
     }
     frame_.inverse_transform = clock.lap();
   } else {

@@ -13,7 +13,8 @@
 //                  on the detailed mesh, with the anchors (the constrained vertices) at their
 //                  exact targets. K is analysed once, factored (CHOLMOD LDL^T) for the first
 //                  anchor set and then updated by the anchors that change (row additions and
-//                  deletions); a frame is O(f) plus one back-substitution with 3 columns.
+//                  deletions); a frame is O(f) plus one back-substitution with 3 columns, both
+//                  on two threads.
 // With s' = s every method returns x (to round-off).
 #pragma once
 

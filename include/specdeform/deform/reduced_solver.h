@@ -7,7 +7,8 @@
 // a diagonal Hessian, the same for x, y and z; no n x n product is ever formed.
 //  - Soft constraints: (D + w H_C^T W_C H_C) c = w H_C^T W_C t, factored (Cholesky, m x m) once
 //    per selection in O(n' m^2 + m^3) — or, when the selection changes by a few vertices, in
-//    O(changed m^2 + m^3) by updating the normal matrix — and solved per frame in O(n' m + m^2).
+//    O(changed m^2 + m^3) by updating the normal matrix — and solved per frame in O(n'' m + m^2),
+//    n'' the constrained vertices that move (the fixed ones add nothing).
 //  - Hard constraints: minimise c^T D c subject to H_C c = t (null-space method on a QR of
 //    H_C^T); needs H_C (n' x m) of full row rank, so n' <= m: otherwise InputError.
 // Targets t are displacements (n' x 3) of the constrained vertices.
@@ -42,10 +43,10 @@ class ReducedSolver {
   Eigen::VectorXd vertex_area_;  // on the unit-area scale
   Eigen::VectorXd hessian_;
   DeformOptions options_;
-  Eigen::MatrixXd rows_;           // H_C, n' x m
-  Eigen::MatrixXd weighted_rows_;  // w W_C H_C (soft)
-  std::vector<char> constrained_;  // soft: the vertices in `normal_`
-  Eigen::MatrixXd normal_;         // soft: D + w H_C^T W_C H_C
+  Eigen::MatrixXd rows_;              // H_C, n' x m
+  Eigen::MatrixXd weighted_columns_;  // (w W_C H_C)^T, m x n' (soft)
+  std::vector<char> constrained_;     // soft: the vertices in `normal_`
+  Eigen::MatrixXd normal_;            // soft: D + w H_C^T W_C H_C
   Eigen::LLT<Eigen::MatrixXd> soft_;
   // Hard: c = Q1 R^-T t + Q2 z, z = -(Q2^T D Q2)^-1 Q2^T D Q1 R^-T t, i.e. c = P t.
   Eigen::MatrixXd hard_;  // P, m x n'

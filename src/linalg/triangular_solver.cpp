@@ -1,0 +1,260 @@
+#include "triangular_solver.h"
+
+#include <cholmod.h>
+
+#include <algorithm>
+#include <barrier>
+#include <cmath>
+#include <queue>
+#include <thread>
+#include <utility>
+
+#include "specdeform/exceptions.h"
+
+namespace specdeform::detail {
+
+namespace {
+
+// Below this many entries of L one thread solves everything: a thread start costs more than
+// the parallel work saves.
+constexpr long kParallelEntries = 150'000;
+// Subtrees are split while one holds more than this share of the work, as long as the
+// separator stays below its cap.
+constexpr double kLargestShare = 0.2;
+constexpr double kSeparatorCap = 0.25;
+constexpr int kMaxWidth = 8;
+
+struct Columns {
+  const int* start;
+  const int* row;
+  const double* value;
+  const double* inv_diagonal;
+};
+
+// L y = b over `columns` (ascending): column j's update of the rows below it.
+template <int W>
+[[gnu::always_inline]] inline void forward(const Columns& L, const std::vector<int>& columns,
+                                           double* x) {
+  for (const int j : columns) {
+    double xj[W];
+    for (int k = 0; k < W; ++k) xj[k] = x[static_cast<size_t>(j) * W + k];
+    for (int e = L.start[j]; e < L.start[j + 1]; ++e) {
+      double* xi = x + static_cast<size_t>(L.row[e]) * W;
+      const double l = L.value[e];
+      for (int k = 0; k < W; ++k) xi[k] -= l * xj[k];
+    }
+  }
+}
+
+// D L^T x = y over `columns` (descending): x_j = y_j / D_j - sum_i L_ij x_i.
+template <int W>
+[[gnu::always_inline]] inline void backward(const Columns& L, const std::vector<int>& columns,
+                                            double* x) {
+  for (auto it = columns.rbegin(); it != columns.rend(); ++it) {
+    const int j = *it;
+    double s[W];
+    for (int k = 0; k < W; ++k) s[k] = x[static_cast<size_t>(j) * W + k] * L.inv_diagonal[j];
+    for (int e = L.start[j]; e < L.start[j + 1]; ++e) {
+      const double* xi = x + static_cast<size_t>(L.row[e]) * W;
+      const double l = L.value[e];
+      for (int k = 0; k < W; ++k) s[k] -= l * xi[k];
+    }
+    for (int k = 0; k < W; ++k) x[static_cast<size_t>(j) * W + k] = s[k];
+  }
+}
+
+// Compiled for AVX2 as well, chosen at run time: no -march flag is needed.
+template <bool Forward>
+__attribute__((target_clones("avx2", "default"))) void substitute_columns(
+    const Columns& L, const std::vector<int>& columns, double* x, int width) {
+  switch (width) {
+#define SPECDEFORM_WIDTH(W)                                           \
+  case W:                                                             \
+    Forward ? forward<W>(L, columns, x) : backward<W>(L, columns, x); \
+    break;
+    SPECDEFORM_WIDTH(1)
+    SPECDEFORM_WIDTH(2)
+    SPECDEFORM_WIDTH(3)
+    SPECDEFORM_WIDTH(4)
+    SPECDEFORM_WIDTH(5)
+    SPECDEFORM_WIDTH(6)
+    SPECDEFORM_WIDTH(7)
+    SPECDEFORM_WIDTH(8)
+#undef SPECDEFORM_WIDTH
+  }
+}
+
+}  // namespace
+
+TriangularSolver::TriangularSolver(cholmod_factor* factor, cholmod_common* common) {
+  if (factor->is_super) {
+    cholmod_change_factor(CHOLMOD_REAL, false, false, true, true, factor, common);
+    if (common->status != CHOLMOD_OK || factor->is_super) {
+      throw SolverError("converting the Cholesky factor failed (out of memory?)");
+    }
+  }
+  if (factor->xtype != CHOLMOD_REAL || factor->itype != CHOLMOD_INT || factor->minor < factor->n) {
+    throw SolverError("triangular solve: not a complete real factorisation");
+  }
+  n_ = static_cast<int>(factor->n);
+  const int* Lp = static_cast<const int*>(factor->p);
+  const int* Li = static_cast<const int*>(factor->i);
+  const int* Lnz = static_cast<const int*>(factor->nz);
+  const double* Lx = static_cast<const double*>(factor->x);
+  const int* perm = static_cast<const int*>(factor->Perm);
+  order_.assign(perm, perm + n_);
+
+  // Copy L (unit diagonal, explicit zeros dropped) and 1 / D; parent[j] = the first row below
+  // the diagonal in column j's stored pattern (the elimination tree).
+  std::vector<int> parent(n_, -1);
+  inv_diagonal_.resize(n_);
+  start_.assign(n_ + 1, 0);
+  row_.reserve(factor->nzmax);
+  value_.reserve(factor->nzmax);
+  for (int j = 0; j < n_; ++j) {
+    const double diagonal = Lx[Lp[j]];
+    const double d = factor->is_ll ? diagonal * diagonal : diagonal;
+    if (!(d != 0.0 && std::isfinite(d))) throw SolverError("triangular solve: singular factor");
+    inv_diagonal_[j] = 1.0 / d;
+    const double scale = factor->is_ll ? 1.0 / diagonal : 1.0;
+    start_[j] = static_cast<int>(row_.size());
+    for (int e = Lp[j] + 1; e < Lp[j] + Lnz[j]; ++e) {
+      if (parent[j] < 0 || Li[e] < parent[j]) parent[j] = Li[e];
+      if (Lx[e] == 0.0) continue;
+      row_.push_back(Li[e]);
+      value_.push_back(Lx[e] * scale);
+    }
+  }
+  start_[n_] = static_cast<int>(row_.size());
+
+  const auto serial_fallback = [&] {
+    forest_[0].resize(n_);
+    for (int j = 0; j < n_; ++j) forest_[0][j] = j;
+    forest_[1].clear();
+    separator_.clear();
+    slots_ = 0;
+    separator_share_ = 0.0;
+  };
+  const long total = static_cast<long>(row_.size()) + n_;
+  if (total < kParallelEntries) {
+    serial_fallback();
+    return;
+  }
+
+  // Split the largest subtree (moving its root into the separator) until no subtree holds much
+  // of the work, then deal the subtrees to two threads, largest first, each to the lighter one.
+  std::vector<long> subtree(n_);
+  std::vector<std::vector<int>> children(n_);
+  for (int j = 0; j < n_; ++j) {
+    subtree[j] += 1 + start_[j + 1] - start_[j];
+    if (parent[j] >= 0) {
+      subtree[parent[j]] += subtree[j];
+      children[parent[j]].push_back(j);
+    }
+  }
+  using Candidate = std::pair<long, int>;  // (subtree work, root)
+  std::priority_queue<Candidate> candidates;
+  for (int j = 0; j < n_; ++j)
+    if (parent[j] < 0) candidates.emplace(subtree[j], j);
+  std::vector<int> owner(n_, -1);  // thread, or 2: separator
+  long separator_work = 0;
+  while (!candidates.empty()) {
+    const auto [work, root] = candidates.top();
+    const long own = 1 + start_[root + 1] - start_[root];
+    if (work <= kLargestShare * total || separator_work + own > kSeparatorCap * total) break;
+    candidates.pop();
+    owner[root] = 2;
+    separator_work += own;
+    for (const int child : children[root]) candidates.emplace(subtree[child], child);
+  }
+  long load[2] = {0, 0};
+  while (!candidates.empty()) {  // popped largest first
+    const auto [work, root] = candidates.top();
+    candidates.pop();
+    const int t = load[0] <= load[1] ? 0 : 1;
+    owner[root] = t;
+    load[t] += work;
+  }
+  for (int j = n_ - 1; j >= 0; --j) {  // a parent comes after its children
+    if (owner[j] < 0) owner[j] = owner[parent[j]];
+  }
+  for (int j = 0; j < n_; ++j) (owner[j] == 2 ? separator_ : forest_[owner[j]]).push_back(j);
+  slots_ = static_cast<int>(separator_.size());
+  std::vector<int> slot(n_, -1);
+  for (int s = 0; s < slots_; ++s) slot[separator_[s]] = s;
+
+  // Every entry of L lies on the path from its column to the root, so a forest's column reaches
+  // only its own forest and the separator; checked all the same. Then the separator rows of
+  // the forests' columns are remapped to the threads' own copies.
+  for (int j = 0; j < n_; ++j) {
+    for (int e = start_[j]; e < start_[j + 1]; ++e) {
+      if (owner[row_[e]] != 2 && owner[row_[e]] != owner[j]) {
+        serial_fallback();
+        return;
+      }
+    }
+  }
+  for (int j = 0; j < n_; ++j) {
+    if (owner[j] == 2) continue;
+    for (int e = start_[j]; e < start_[j + 1]; ++e) {
+      if (owner[row_[e]] == 2) row_[e] = n_ + owner[j] * slots_ + slot[row_[e]];
+    }
+  }
+  separator_share_ = static_cast<double>(separator_work) / total;
+}
+
+void TriangularSolver::solve_in_place(double* x, int width) const {
+  if (width < 1 || width > kMaxWidth)
+    throw InputError("triangular solve: 1 to 8 columns at a time");
+  const Columns L{start_.data(), row_.data(), value_.data(), inv_diagonal_.data()};
+  std::fill_n(x + static_cast<size_t>(n_) * width, static_cast<size_t>(2 * slots_) * width, 0.0);
+  if (forest_[1].empty() && separator_.empty()) {
+    substitute_columns<true>(L, forest_[0], x, width);
+    substitute_columns<false>(L, forest_[0], x, width);
+    return;
+  }
+  const auto row = [&](int i) { return x + static_cast<size_t>(i) * width; };
+  std::barrier sync(2);
+  const auto work = [&](int t) {
+    substitute_columns<true>(L, forest_[t], x, width);
+    sync.arrive_and_wait();
+    if (t == 0) {
+      for (int s = 0; s < slots_; ++s) {
+        double* xs = row(separator_[s]);
+        const double* a = row(n_ + s);
+        const double* b = row(n_ + slots_ + s);
+        for (int k = 0; k < width; ++k) xs[k] += a[k] + b[k];
+      }
+      substitute_columns<true>(L, separator_, x, width);
+      substitute_columns<false>(L, separator_, x, width);
+      for (int s = 0; s < slots_; ++s) {
+        const double* xs = row(separator_[s]);
+        std::copy(xs, xs + width, row(n_ + s));
+        std::copy(xs, xs + width, row(n_ + slots_ + s));
+      }
+    }
+    sync.arrive_and_wait();
+    substitute_columns<false>(L, forest_[t], x, width);
+  };
+  std::thread helper(work, 1);
+  work(0);
+  helper.join();
+}
+
+Eigen::MatrixXd TriangularSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& B) const {
+  if (B.rows() != n_) throw InputError("triangular solve: right-hand side of the wrong size");
+  Eigen::MatrixXd X(n_, B.cols());
+  std::vector<double> x;
+  for (Eigen::Index c0 = 0; c0 < B.cols(); c0 += kMaxWidth) {
+    const int width = static_cast<int>(std::min<Eigen::Index>(kMaxWidth, B.cols() - c0));
+    x.resize(static_cast<size_t>(workspace_rows()) * width);
+    for (int k = 0; k < n_; ++k)
+      for (int c = 0; c < width; ++c) x[static_cast<size_t>(k) * width + c] = B(order_[k], c0 + c);
+    solve_in_place(x.data(), width);
+    for (int k = 0; k < n_; ++k)
+      for (int c = 0; c < width; ++c) X(order_[k], c0 + c) = x[static_cast<size_t>(k) * width + c];
+  }
+  return X;
+}
+
+}  // namespace specdeform::detail
