@@ -20,24 +20,35 @@ ReducedSolver::ReducedSolver(const Eigen::MatrixXd& basis, const Eigen::VectorXd
 void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
   const int m = static_cast<int>(basis_.cols());
   const int nc = static_cast<int>(vertices.size());
-  rows_.resize(nc, m);
-  for (int i = 0; i < nc; ++i) rows_.row(i) = basis_.row(vertices[i]);
-  if (options_.constraints == ConstraintMode::Soft) {
-    Eigen::VectorXd w(nc);
-    for (int i = 0; i < nc; ++i) w[i] = options_.constraint_weight * vertex_area_[vertices[i]];
-    weighted_columns_ = (w.asDiagonal() * rows_).transpose();
-    // Update the normal matrix by the vertices that changed, or rebuild it when many did.
-    std::vector<char> next(basis_.rows(), 0);
-    for (const int v : vertices) next[v] = 1;
-    std::vector<int> added, removed;
-    if (!constrained_.empty()) {
-      for (int v = 0; v < static_cast<int>(basis_.rows()); ++v) {
-        if (next[v] && !constrained_[v]) added.push_back(v);
-        if (!next[v] && constrained_[v]) removed.push_back(v);
-      }
+  // H_C^T: columns of the previous selection are copied (contiguous), only new vertices'
+  // rows are gathered from the basis.
+  Eigen::MatrixXd columns(m, nc);
+  for (int i = 0; i < nc; ++i) {
+    const int v = vertices[i];
+    if (column_of_.empty() || column_of_[v] < 0) {
+      columns.col(i) = basis_.row(v).transpose();
+    } else {
+      columns.col(i) = columns_.col(column_of_[v]);
     }
-    if (constrained_.empty() || 2 * (added.size() + removed.size()) > vertices.size()) {
-      normal_ = weighted_columns_ * rows_;
+  }
+  std::vector<int> added, removed;
+  std::vector<int> column_of(basis_.rows(), -1);
+  for (int i = 0; i < nc; ++i) column_of[vertices[i]] = i;
+  if (!column_of_.empty()) {
+    for (int v = 0; v < static_cast<int>(basis_.rows()); ++v) {
+      if (column_of[v] >= 0 && column_of_[v] < 0) added.push_back(v);
+      if (column_of[v] < 0 && column_of_[v] >= 0) removed.push_back(v);
+    }
+  }
+  const bool rebuild = column_of_.empty() || 2 * (added.size() + removed.size()) > vertices.size();
+  column_of_ = std::move(column_of);
+  columns_ = std::move(columns);
+  weights_.resize(nc);
+  for (int i = 0; i < nc; ++i) weights_[i] = options_.constraint_weight * vertex_area_[vertices[i]];
+  if (options_.constraints == ConstraintMode::Soft) {
+    // Update the normal matrix by the vertices that changed, or rebuild it when many did.
+    if (rebuild) {
+      normal_ = columns_ * weights_.asDiagonal() * columns_.transpose();
       normal_.diagonal() += hessian_;
     } else {
       const auto update = [&](const std::vector<int>& changed, double sign) {
@@ -52,7 +63,6 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
       update(added, 1.0);
       update(removed, -1.0);
     }
-    constrained_ = std::move(next);
     soft_.compute(normal_);
     if (soft_.info() != Eigen::Success) {
       throw SolverError(
@@ -66,7 +76,7 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
                      std::to_string(m) +
                      " modes; use soft constraints, fewer constrained vertices or more modes");
   }
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(rows_.transpose());  // H_C^T = Q R P^T
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(columns_);  // H_C^T = Q R P^T
   qr.setThreshold(1e-10);
   if (qr.rank() < nc) {
     throw InputError("hard constraints: the basis can meet only " + std::to_string(qr.rank()) +
@@ -92,17 +102,19 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
 }
 
 Eigen::MatrixX3d ReducedSolver::solve(const Eigen::MatrixX3d& targets) const {
-  if (targets.rows() != rows_.rows()) {
+  if (targets.rows() != columns_.cols()) {
     throw InputError("deformation: targets for " + std::to_string(targets.rows()) +
-                     " vertices, the selection has " + std::to_string(rows_.rows()));
+                     " vertices, the selection has " + std::to_string(columns_.cols()));
   }
   // Outer products and vector solves: no BLAS call, whose worker threads would spin on the
   // second core while the rest of the frame needs it. Vertices that keep their place (the
   // fixed ones, typically most) add nothing to the right-hand side.
   if (options_.constraints == ConstraintMode::Soft) {
-    Eigen::MatrixX3d c = Eigen::MatrixX3d::Zero(weighted_columns_.rows(), 3);
+    Eigen::MatrixX3d c = Eigen::MatrixX3d::Zero(columns_.rows(), 3);
     for (Eigen::Index i = 0; i < targets.rows(); ++i) {
-      if (!targets.row(i).isZero(0.0)) c.noalias() += weighted_columns_.col(i) * targets.row(i);
+      if (!targets.row(i).isZero(0.0)) {
+        c.noalias() += columns_.col(i) * (weights_[i] * targets.row(i));
+      }
     }
     for (int d = 0; d < 3; ++d) c.col(d) = soft_.solve(c.col(d));
     return c;

@@ -87,6 +87,10 @@ __attribute__((target_clones("avx2", "default"))) void substitute_columns(
 }  // namespace
 
 TriangularSolver::TriangularSolver(cholmod_factor* factor, cholmod_common* common) {
+  assign(factor, common);
+}
+
+void TriangularSolver::assign(cholmod_factor* factor, cholmod_common* common) {
   if (factor->is_super) {
     cholmod_change_factor(CHOLMOD_REAL, false, false, true, true, factor, common);
     if (common->status != CHOLMOD_OK || factor->is_super) {
@@ -96,6 +100,10 @@ TriangularSolver::TriangularSolver(cholmod_factor* factor, cholmod_common* commo
   if (factor->xtype != CHOLMOD_REAL || factor->itype != CHOLMOD_INT || factor->minor < factor->n) {
     throw SolverError("triangular solve: not a complete real factorisation");
   }
+  copy(factor, true);
+}
+
+void TriangularSolver::copy(const cholmod_factor* factor, bool parallel) {
   n_ = static_cast<int>(factor->n);
   const int* Lp = static_cast<const int*>(factor->p);
   const int* Li = static_cast<const int*>(factor->i);
@@ -106,26 +114,32 @@ TriangularSolver::TriangularSolver(cholmod_factor* factor, cholmod_common* commo
 
   // Copy L (unit diagonal, explicit zeros dropped) and 1 / D; parent[j] = the first row below
   // the diagonal in column j's stored pattern (the elimination tree).
+  // The buffers keep their memory from one factor to the next (no page faults on reuse).
   std::vector<int> parent(n_, -1);
   inv_diagonal_.resize(n_);
-  start_.assign(n_ + 1, 0);
-  row_.reserve(factor->nzmax);
-  value_.reserve(factor->nzmax);
+  start_.resize(n_ + 1);
+  row_.resize(factor->nzmax);
+  value_.resize(factor->nzmax);
+  int count = 0;
   for (int j = 0; j < n_; ++j) {
     const double diagonal = Lx[Lp[j]];
     const double d = factor->is_ll ? diagonal * diagonal : diagonal;
     if (!(d != 0.0 && std::isfinite(d))) throw SolverError("triangular solve: singular factor");
     inv_diagonal_[j] = 1.0 / d;
     const double scale = factor->is_ll ? 1.0 / diagonal : 1.0;
-    start_[j] = static_cast<int>(row_.size());
+    start_[j] = count;
     for (int e = Lp[j] + 1; e < Lp[j] + Lnz[j]; ++e) {
       if (parent[j] < 0 || Li[e] < parent[j]) parent[j] = Li[e];
       if (Lx[e] == 0.0) continue;
-      row_.push_back(Li[e]);
-      value_.push_back(Lx[e] * scale);
+      row_[count] = Li[e];
+      value_[count++] = Lx[e] * scale;
     }
   }
-  start_[n_] = static_cast<int>(row_.size());
+  start_[n_] = count;
+  row_.resize(count);
+  value_.resize(count);
+  for (auto& list : forest_) list.clear();
+  separator_.clear();
 
   const auto serial_fallback = [&] {
     forest_[0].resize(n_);
@@ -136,21 +150,27 @@ TriangularSolver::TriangularSolver(cholmod_factor* factor, cholmod_common* commo
     separator_share_ = 0.0;
   };
   const long total = static_cast<long>(row_.size()) + n_;
-  if (total < kParallelEntries) {
+  if (!parallel || total < kParallelEntries) {
     serial_fallback();
     return;
   }
 
   // Split the largest subtree (moving its root into the separator) until no subtree holds much
   // of the work, then deal the subtrees to two threads, largest first, each to the lighter one.
-  std::vector<long> subtree(n_);
-  std::vector<std::vector<int>> children(n_);
+  std::vector<long> subtree(n_, 0);
+  std::vector<int> first_child(n_ + 1, 0), children(n_);  // children of j: CSR
   for (int j = 0; j < n_; ++j) {
     subtree[j] += 1 + start_[j + 1] - start_[j];
     if (parent[j] >= 0) {
       subtree[parent[j]] += subtree[j];
-      children[parent[j]].push_back(j);
+      ++first_child[parent[j] + 1];
     }
+  }
+  for (int j = 0; j < n_; ++j) first_child[j + 1] += first_child[j];
+  {
+    std::vector<int> next(first_child.begin(), first_child.end() - 1);
+    for (int j = 0; j < n_; ++j)
+      if (parent[j] >= 0) children[next[parent[j]]++] = j;
   }
   using Candidate = std::pair<long, int>;  // (subtree work, root)
   std::priority_queue<Candidate> candidates;
@@ -165,7 +185,8 @@ TriangularSolver::TriangularSolver(cholmod_factor* factor, cholmod_common* commo
     candidates.pop();
     owner[root] = 2;
     separator_work += own;
-    for (const int child : children[root]) candidates.emplace(subtree[child], child);
+    for (int c = first_child[root]; c < first_child[root + 1]; ++c)
+      candidates.emplace(subtree[children[c]], children[c]);
   }
   long load[2] = {0, 0};
   while (!candidates.empty()) {  // popped largest first
@@ -184,20 +205,17 @@ TriangularSolver::TriangularSolver(cholmod_factor* factor, cholmod_common* commo
   for (int s = 0; s < slots_; ++s) slot[separator_[s]] = s;
 
   // Every entry of L lies on the path from its column to the root, so a forest's column reaches
-  // only its own forest and the separator; checked all the same. Then the separator rows of
-  // the forests' columns are remapped to the threads' own copies.
+  // only its own forest and the separator (checked all the same): its separator rows are
+  // remapped to the thread's own copies.
   for (int j = 0; j < n_; ++j) {
     for (int e = start_[j]; e < start_[j + 1]; ++e) {
-      if (owner[row_[e]] != 2 && owner[row_[e]] != owner[j]) {
-        serial_fallback();
+      const int i = row_[e];
+      if (owner[i] == owner[j]) continue;
+      if (owner[i] != 2) {  // not an elimination tree: redo the copy, for one thread
+        copy(factor, false);
         return;
       }
-    }
-  }
-  for (int j = 0; j < n_; ++j) {
-    if (owner[j] == 2) continue;
-    for (int e = start_[j]; e < start_[j + 1]; ++e) {
-      if (owner[row_[e]] == 2) row_[e] = n_ + owner[j] * slots_ + slot[row_[e]];
+      row_[e] = n_ + owner[j] * slots_ + slot[i];
     }
   }
   separator_share_ = static_cast<double>(separator_work) / total;

@@ -25,6 +25,8 @@ class TriangularSolver {
   // `factor`: numeric, simplicial or supernodal, LL^T or LDL^T. A supernodal factor is first
   // converted, in place, to a simplicial LDL^T one (cholmod_change_factor).
   TriangularSolver(cholmod_factor_struct* factor, cholmod_common_struct* common);
+  // The same for a new factor, reusing this solver's memory.
+  void assign(cholmod_factor_struct* factor, cholmod_common_struct* common);
 
   // A^-1 B for B n x k, any k.
   Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& B) const;
@@ -42,6 +44,8 @@ class TriangularSolver {
   double separator_share() const { return separator_share_; }
 
  private:
+  void copy(const cholmod_factor_struct* factor, bool parallel);
+
   int n_ = 0;
   std::vector<int> order_;            // factor row k is unknown order_[k]
   std::vector<double> inv_diagonal_;  // 1 / D

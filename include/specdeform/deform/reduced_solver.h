@@ -43,10 +43,10 @@ class ReducedSolver {
   Eigen::VectorXd vertex_area_;  // on the unit-area scale
   Eigen::VectorXd hessian_;
   DeformOptions options_;
-  Eigen::MatrixXd rows_;              // H_C, n' x m
-  Eigen::MatrixXd weighted_columns_;  // (w W_C H_C)^T, m x n' (soft)
-  std::vector<char> constrained_;     // soft: the vertices in `normal_`
-  Eigen::MatrixXd normal_;            // soft: D + w H_C^T W_C H_C
+  Eigen::MatrixXd columns_;     // H_C^T, m x n'
+  Eigen::VectorXd weights_;     // w W_C (n')
+  std::vector<int> column_of_;  // vertex -> its column of columns_, or -1
+  Eigen::MatrixXd normal_;      // soft: D + w H_C^T W_C H_C
   Eigen::LLT<Eigen::MatrixXd> soft_;
   // Hard: c = Q1 R^-T t + Q2 z, z = -(Q2^T D Q2)^-1 Q2^T D Q1 R^-T t, i.e. c = P t.
   Eigen::MatrixXd hard_;  // P, m x n'
