@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "linalg/parallel.h"
+#include "parallel.h"
 #include "specdeform/exceptions.h"
 
 namespace specdeform::detail {

@@ -6,9 +6,9 @@
 #include <barrier>
 #include <cmath>
 #include <queue>
-#include <thread>
 #include <utility>
 
+#include "parallel.h"
 #include "specdeform/exceptions.h"
 
 namespace specdeform::detail {
@@ -254,9 +254,7 @@ void TriangularSolver::solve_in_place(double* x, int width) const {
     sync.arrive_and_wait();
     substitute_columns<false>(L, forest_[t], x, width);
   };
-  std::thread helper(work, 1);
-  work(0);
-  helper.join();
+  run_pair([&] { work(0); }, [&] { work(1); });
 }
 
 Eigen::MatrixXd TriangularSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& B) const {
