@@ -33,10 +33,18 @@
 
 namespace specdeform::server {
 
+// Solver settings of the editor: the library's, but frames with the basis in single precision
+// (twice as fast an inverse transform; a displacement error of about 1e-7 of itself).
+inline DeformOptions editor_deform_options() {
+  DeformOptions o;
+  o.float32_basis = true;
+  return o;
+}
+
 struct EditorConfig {
-  int modes = 100;                  // m of a newly opened mesh
-  DeformOptions options;            // solver settings of a newly opened mesh
-  std::filesystem::path cache_dir;  // basis cache; empty: none
+  int modes = 100;                                  // m of a newly opened mesh
+  DeformOptions options = editor_deform_options();  // solver settings of a newly opened mesh
+  std::filesystem::path cache_dir;                  // basis cache; empty: none
 };
 
 // Thrown from a progress report after cancel(): the computation is abandoned.

@@ -66,6 +66,8 @@ struct DetailReconstruction::Poisson {
   std::vector<int> order;  // row k is vertex order[k] of the mesh
   std::vector<int> rank;   // and vertex i of the mesh is row rank[i]
   Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> faces;  // sorted by their first row
+  // Per-frame buffers, kept: a fresh allocation of this size costs its page faults each frame.
+  RowMajor positions, face_normals, x;
 };
 
 namespace {
@@ -224,7 +226,7 @@ void DetailReconstruction::set_anchors(const std::vector<int>& vertices) {
   p.coupling.setFromTriplets(coupling.begin(), coupling.end());
 }
 
-Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& anchors) const {
+Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& anchors) {
   switch (method_) {
     case DetailMethod::None:
       return s;
@@ -245,18 +247,23 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
     case DetailMethod::Transfer:
       break;
   }
-  const Poisson& p = *poisson_;
+  Poisson& p = *poisson_;
   if (anchors.rows() != static_cast<Eigen::Index>(p.anchors.size())) {
     throw InputError("deformation transfer: anchor positions do not match the anchors");
   }
   const int n = static_cast<int>(s.rows());
-  RowMajor positions(n, 3);
-  for (int k = 0; k < n; ++k) positions.row(k) = s.row(p.order[k]);
-  RowMajor normals(faces_.rows(), 3);
+  RowMajor& positions = p.positions;
+  RowMajor& normals = p.face_normals;
+  RowMajor& x = p.x;  // the right-hand side, then the solution
+  positions.resize(n, 3);
+  normals.resize(faces_.rows(), 3);
+  x.resize(p.system->workspace_rows(), 3);
+  detail::split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index k = begin; k < end; ++k) positions.row(k) = s.row(p.order[k]);
+  });
   detail::split_in_two(faces_.rows(), [&](Eigen::Index begin, Eigen::Index end) {
     unit_normals(p.faces.data(), positions.data(), begin, end, normals.data());
   });
-  RowMajor x(p.system->workspace_rows(), 3);  // the right-hand side, then the solution
   detail::split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
     x.middleRows(begin, end - begin) = p.constant.middleRows(begin, end - begin);
     add_product(p.edges, positions.data(), begin, end, x.data());
@@ -268,7 +275,9 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
   for (size_t i = 0; i < p.anchors.size(); ++i) x.row(p.anchors[i]) = anchors.row(i);
   p.system->solve_in_place(x.data());
   Vertices out(n, 3);
-  for (int k = 0; k < n; ++k) out.row(p.order[k]) = x.row(k);
+  detail::split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index k = begin; k < end; ++k) out.row(p.order[k]) = x.row(k);
+  });
   return out;
 }
 

@@ -100,11 +100,10 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
   if (reduced_) {
     const Eigen::MatrixX3d c = reduced_->solve(displacement_targets);
     frame_.reduced_solve = clock.lap();
-    deformed_base_ = base_;
     if (options_.float32_basis) {
-      detail::add_basis_product(basis32_, c, deformed_base_);
+      detail::add_basis_product(base_, basis32_, c, deformed_base_);
     } else {
-      detail::add_basis_product(basis_.basis, c, deformed_base_);
+      detail::add_basis_product(base_, basis_.basis, c, deformed_base_);
     }
     frame_.inverse_transform = clock.lap();
   } else {

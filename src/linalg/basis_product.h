@@ -1,5 +1,5 @@
-// Internal: out += H C for a tall basis H (n x m, column-major, double or float) and C (m x 3),
-// the inverse manifold-harmonics transform of one deformation frame. Memory-bound (H is read
+// Internal: out = base + H C for a tall basis H (n x m, column-major, double or float) and C (m x
+// 3), the inverse manifold-harmonics transform of one deformation frame. Memory-bound (H is read
 // once): rows are processed in blocks whose three accumulators stay in the L1 cache, and the
 // blocks are split between two threads. Plain loops rather than a BLAS call, which would pack
 // (copy) all of H first.
@@ -9,7 +9,10 @@
 
 namespace specdeform::detail {
 
-void add_basis_product(const Eigen::MatrixXd& H, const Eigen::MatrixX3d& C, Eigen::MatrixX3d& out);
-void add_basis_product(const Eigen::MatrixXf& H, const Eigen::MatrixX3d& C, Eigen::MatrixX3d& out);
+// `out` is resized to n x 3.
+void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXd& H,
+                       const Eigen::MatrixX3d& C, Eigen::MatrixX3d& out);
+void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXf& H,
+                       const Eigen::MatrixX3d& C, Eigen::MatrixX3d& out);
 
 }  // namespace specdeform::detail

@@ -38,8 +38,9 @@ class DetailReconstruction {
   // Transfer: factors the Poisson system with these vertices anchored. Other methods: nothing.
   void set_anchors(const std::vector<int>& vertices);
 
-  // anchor_positions: exact positions of the anchors (n' x 3, Transfer only).
-  Vertices apply(const Vertices& deformed_base, const Eigen::MatrixX3d& anchor_positions) const;
+  // anchor_positions: exact positions of the anchors (n' x 3, Transfer only). Reuses buffers
+  // of the previous call (not reentrant).
+  Vertices apply(const Vertices& deformed_base, const Eigen::MatrixX3d& anchor_positions);
 
   DetailMethod method() const { return method_; }
 
