@@ -12,10 +12,14 @@
 #include <string>
 #include <vector>
 
+#include <cholmod.h>
+
 #include <Spectra/SymGEigsShiftSolver.h>
 #include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
 
+#include "linalg/parallel.h"
+#include "linalg/triangular_solver.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/operators/cotan_laplacian.h"
 
@@ -60,15 +64,34 @@ Mat random_block(int rows, int cols, std::mt19937_64& rng) {
   return X;
 }
 
-// Factorization of S = K - sigma M: supernodal LL^T when sigma is below the spectrum (S positive
-// definite), simplicial LDL^T for an interior shift. A shift that falls (nearly) on an eigenvalue
-// makes S (nearly) singular: `usable()` tells, and the caller moves the shift.
+// Factorization of S = K - sigma M with CHOLMOD: supernodal LL^T when sigma is below the
+// spectrum (S positive definite), simplicial LDL^T for an interior shift; then solved with
+// linalg/triangular_solver.h (two threads, a block of right-hand sides interleaved). A shift
+// that falls (nearly) on an eigenvalue makes S (nearly) singular: `usable()` tells, and the
+// caller moves the shift.
 class ShiftInvert {
  public:
   ShiftInvert(const Sparse& K, const Sparse& M, double sigma, std::mt19937_64& rng)
       : sigma_(sigma), S_(K - sigma * M) {
-    ok_ = definite() ? (llt_.compute(S_), llt_.info() == Eigen::Success)
-                     : (ldlt_.compute(S_), ldlt_.info() == Eigen::Success);
+    cholmod_common common;
+    cholmod_start(&common);
+    common.supernodal = definite() ? CHOLMOD_SUPERNODAL : CHOLMOD_SIMPLICIAL;
+    common.final_ll = definite();
+    Sparse lower = S_.triangularView<Eigen::Lower>();
+    cholmod_sparse A = Eigen::viewAsCholmod(lower);
+    A.stype = -1;
+    cholmod_factor* factor = cholmod_analyze(&A, &common);
+    ok_ = factor != nullptr && cholmod_factorize(&A, factor, &common) &&
+          common.status == CHOLMOD_OK && factor->minor == factor->n;
+    if (ok_) {
+      try {
+        solver_.assign(factor, &common);
+      } catch (const SolverError&) {
+        ok_ = false;
+      }
+    }
+    cholmod_free_factor(&factor, &common);
+    cholmod_finish(&common);
     if (ok_ && !definite()) {
       const Mat b = random_block(static_cast<int>(S_.rows()), 1, rng);
       const Mat x = solve(b);
@@ -79,9 +102,9 @@ class ShiftInvert {
   // LDL^T of an indefinite matrix is computed without pivoting; one step of iterative
   // refinement brings its solves from ~1e-10 back to round-off, which the Krylov relation needs.
   Mat solve(const Mat& B) const {
-    if (definite()) return llt_.solve(B);
-    Mat X = ldlt_.solve(B);
-    X += ldlt_.solve(B - S_ * X);
+    if (definite()) return solver_.solve(B);
+    Mat X = solver_.solve(B);
+    X += solver_.solve(B - S_ * X);
     return X;
   }
   double sigma() const { return sigma_; }
@@ -91,18 +114,32 @@ class ShiftInvert {
   double sigma_;
   Sparse S_;
   bool ok_ = false;
-  Eigen::CholmodSupernodalLLT<Sparse, Eigen::Lower> llt_;
-  Eigen::CholmodSimplicialLDLT<Sparse, Eigen::Lower> ldlt_;
+  detail::TriangularSolver solver_;
 };
 
 Vec m_norms(const Mat& X, const MassOperator& M) {
   return M.apply(X).cwiseProduct(X).colwise().sum().cwiseMax(0.0).cwiseSqrt().transpose();
 }
 
+// Cholesky QR, twice (Fukaya et al. 2014): W := W R^-1 with R^T R = W^T M W. BLAS-3; accurate
+// when W is not too ill-conditioned, false (W spanning the same space) where it is.
+bool cholesky_qr2(Mat& W, const MassOperator& M) {
+  for (int pass = 0; pass < 2; ++pass) {
+    const Mat G = W.transpose() * M.apply(W);
+    const Eigen::LLT<Mat> llt(0.5 * (G + G.transpose()));
+    if (llt.info() != Eigen::Success) return false;
+    const Vec r = llt.matrixLLT().diagonal();
+    if (!(r.minCoeff() > 1e-6 * r.maxCoeff())) return false;
+    llt.matrixU().solveInPlace<Eigen::OnTheRight>(W);
+  }
+  return true;
+}
+
 // Makes the columns of W M-orthonormal and M-orthogonal to the columns of each basis in `against`
 // (each M-orthonormal): block classical Gram-Schmidt against the bases (BLAS-3), repeated only
-// when it cancelled most of a column (Kahan-Parlett "twice is enough"), then Gram-Schmidt within
-// the block. A column that vanishes is replaced by a random one.
+// when it cancelled most of a column (Kahan-Parlett "twice is enough"), then Cholesky QR within
+// the block, or Gram-Schmidt where W is ill-conditioned. A column that vanishes is replaced by a
+// random one.
 using Basis = Eigen::Ref<const Mat>;
 
 void orthonormalize(Mat& W, std::initializer_list<Basis> against, const MassOperator& M,
@@ -118,6 +155,7 @@ void orthonormalize(Mat& W, std::initializer_list<Basis> against, const MassOper
       if ((after.array() > 0.5 * before.array()).all()) break;
       before = after;
     }
+    if (cholesky_qr2(W, M)) return;
     bool replaced = false;
     for (int j = 0; j < W.cols(); ++j) {
       const double norm0 = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
@@ -280,7 +318,8 @@ void rayleigh_ritz(const Sparse& K, const MassOperator& M, Mat& H, Vec& lambda) 
   lambda = eig.eigenvalues();
 }
 
-// Adapters that make the CHOLMOD shift-invert operator and M usable by Spectra.
+// Adapters that make a plain CHOLMOD shift-invert operator (supernodal LL^T, cholmod_solve) and
+// M usable by Spectra: the baseline as the literature runs it.
 class SpectraShiftInvertOp {
  public:
   using Scalar = double;
@@ -288,11 +327,11 @@ class SpectraShiftInvertOp {
   Eigen::Index rows() const { return K_.rows(); }
   Eigen::Index cols() const { return K_.cols(); }
   void set_shift(double sigma) {
-    op_.emplace(K_, M_, sigma, rng_);
-    if (!op_->usable()) throw SolverError("factorization of K - sigma M failed");
+    llt_.compute(K_ - sigma * M_);
+    if (llt_.info() != Eigen::Success) throw SolverError("factorization of K - sigma M failed");
   }
   void perform_op(const double* x, double* y) const {
-    Eigen::Map<Vec>(y, rows()) = op_->solve(Eigen::Map<const Vec>(x, rows()));
+    Eigen::Map<Vec>(y, rows()) = llt_.solve(Eigen::Map<const Vec>(x, rows()));
     ++solves_;
   }
   long long solves() const { return solves_; }
@@ -300,8 +339,7 @@ class SpectraShiftInvertOp {
  private:
   const Sparse& K_;
   const Sparse& M_;
-  std::optional<ShiftInvert> op_;
-  std::mt19937_64 rng_{1};
+  Eigen::CholmodSupernodalLLT<Sparse, Eigen::Lower> llt_;
   mutable long long solves_ = 0;
 };
 
@@ -376,25 +414,49 @@ struct PairErrors {
   Vec residual, floor;
 };
 
+// In blocks of kColumns pairs, each copied row-major, rows split between two threads: per row
+// of K (CSR) one pass over its entries serves all the block's residuals and floors.
 PairErrors pair_errors(const Sparse& K, const Sparse& M, const Mat& H, const Vec& lambda) {
+  constexpr int kColumns = 16;
+  using RowSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+  using Block = Eigen::Matrix<double, Eigen::Dynamic, kColumns, Eigen::RowMajor>;
+  using Sums = Eigen::Array<double, kColumns, 1>;
+  const RowSparse Kr = K, Mr = M;
   const double area = M.sum();
   const Vec d_inv = (M * Vec::Ones(M.rows())).cwiseInverse();
-  const Sparse K_abs = K.cwiseAbs(), M_abs = M.cwiseAbs();
+  const Eigen::Index n = H.rows();
   PairErrors out{Vec(H.cols()), Vec(H.cols())};
-  constexpr int kColumns = 64;  // in blocks, to bound the temporaries
+  Block block(n, kColumns);
   for (Eigen::Index j = 0; j < H.cols(); j += kColumns) {
     const Eigen::Index c = std::min<Eigen::Index>(kColumns, H.cols() - j);
-    const auto block = H.middleCols(j, c);
-    const auto l = lambda.segment(j, c);
-    const Mat R = K * block - (M * block) * l.asDiagonal();
-    const Mat abs_block = block.cwiseAbs();
-    const Mat bound = K_abs * abs_block + (M_abs * abs_block) * l.cwiseAbs().asDiagonal();
-    const Vec r = R.cwiseAbs2().transpose() * d_inv;
-    const Vec b = bound.cwiseAbs2().transpose() * d_inv;
-    for (Eigen::Index i = 0; i < c; ++i) {
-      const double scale = area / std::max(area * lambda[j + i], 1.0);
-      out.residual[j + i] = scale * std::sqrt(r[i]);
-      out.floor[j + i] = scale * std::numeric_limits<double>::epsilon() * std::sqrt(b[i]);
+    block.setZero();
+    block.leftCols(c) = H.middleCols(j, c);
+    Sums l = Sums::Zero();
+    l.head(c) = lambda.segment(j, c).array();
+    Sums residual2[2] = {Sums::Zero(), Sums::Zero()}, floor2[2] = {Sums::Zero(), Sums::Zero()};
+    detail::split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
+      const int t = begin == 0 ? 0 : 1;
+      for (Eigen::Index i = begin; i < end; ++i) {
+        Sums kh = Sums::Zero(), mh = Sums::Zero(), kh_abs = Sums::Zero(), mh_abs = Sums::Zero();
+        for (RowSparse::InnerIterator it(Kr, i); it; ++it) {
+          const Sums h = block.row(it.col()).transpose().array();
+          kh += it.value() * h;
+          kh_abs += std::abs(it.value()) * h.abs();
+        }
+        for (RowSparse::InnerIterator it(Mr, i); it; ++it) {
+          const Sums h = block.row(it.col()).transpose().array();
+          mh += it.value() * h;
+          mh_abs += std::abs(it.value()) * h.abs();
+        }
+        residual2[t] += d_inv[i] * (kh - l * mh).square();
+        floor2[t] += d_inv[i] * (kh_abs + l.abs() * mh_abs).square();
+      }
+    });
+    for (Eigen::Index p = 0; p < c; ++p) {
+      const double scale = area / std::max(area * lambda[j + p], 1.0);
+      out.residual[j + p] = scale * std::sqrt(residual2[0][p] + residual2[1][p]);
+      out.floor[j + p] =
+          scale * std::numeric_limits<double>::epsilon() * std::sqrt(floor2[0][p] + floor2[1][p]);
     }
   }
   return out;
@@ -499,14 +561,16 @@ Spectrum solve_block_krylov(const Sparse& K, const Sparse& Mmat, int m,
     rayleigh_ritz(K, M, r.H, r.lambda);
     std::vector<double> seen(1, count > 0 ? last : sigma);
     seen.insert(seen.end(), r.lambda.begin(), r.lambda.end());
-    const auto [residual, floors] = pair_errors(K, Mmat, r.H, r.lambda);
-    if (sigma > 0.0 && r.converged && !residuals_within(residual, floors, o.tolerance, 10)) {
-      // Inaccurate solves broke the Krylov relation (a shift close to an eigenvalue): redo the
-      // band with the shift in a gap between the eigenvalues seen.
-      retry(clear_shift(sigma, seen));
-      continue;
+    if (sigma > 0.0) {  // an interior shift: check the band (the caller checks all pairs)
+      const auto [residual, floors] = pair_errors(K, Mmat, r.H, r.lambda);
+      if (r.converged && !residuals_within(residual, floors, o.tolerance, 10)) {
+        // Inaccurate solves broke the Krylov relation (a shift close to an eigenvalue): redo
+        // the band with the shift in a gap between the eigenvalues seen.
+        retry(clear_shift(sigma, seen));
+        continue;
+      }
+      if (!residuals_within(residual, floors, o.tolerance, 100)) r.converged = false;
     }
-    if (!residuals_within(residual, floors, o.tolerance, 100)) r.converged = false;
     double radius = 0.0;
     for (int i = 0; i < r.lambda.size(); ++i)
       radius = std::max(radius, std::abs(r.lambda[i] - sigma));
