@@ -49,6 +49,18 @@ class MassOperator {
     if (diagonal_) return d_.asDiagonal() * X;
     return M_ * X;
   }
+  // X^T M X; for a diagonal M in blocks of rows, without an n x k temporary.
+  Mat gram(const Mat& X) const {
+    if (!diagonal_) return X.transpose() * (M_ * X);
+    constexpr Eigen::Index kRows = 4096;
+    Mat G = Mat::Zero(X.cols(), X.cols());
+    for (Eigen::Index r = 0; r < X.rows(); r += kRows) {
+      const Eigen::Index rows = std::min(kRows, X.rows() - r);
+      const auto block = X.middleRows(r, rows);
+      G.noalias() += block.transpose() * (d_.segment(r, rows).asDiagonal() * block);
+    }
+    return G;
+  }
   const Sparse& matrix() const { return M_; }
 
  private:
@@ -125,7 +137,7 @@ Vec m_norms(const Mat& X, const MassOperator& M) {
 // when W is not too ill-conditioned, false (W spanning the same space) where it is.
 bool cholesky_qr2(Mat& W, const MassOperator& M) {
   for (int pass = 0; pass < 2; ++pass) {
-    const Mat G = W.transpose() * M.apply(W);
+    const Mat G = M.gram(W);
     const Eigen::LLT<Mat> llt(0.5 * (G + G.transpose()));
     if (llt.info() != Eigen::Success) return false;
     const Vec r = llt.matrixLLT().diagonal();
@@ -144,6 +156,9 @@ using Basis = Eigen::Ref<const Mat>;
 
 void orthonormalize(Mat& W, std::initializer_list<Basis> against, const MassOperator& M,
                     std::mt19937_64& rng) {
+  const bool alone =
+      std::all_of(against.begin(), against.end(), [](const Basis& B) { return B.cols() == 0; });
+  if (alone && cholesky_qr2(W, M)) return;
   for (int attempt = 0; attempt < 3; ++attempt) {
     Vec before = m_norms(W, M);
     for (int pass = 0; pass < 2; ++pass) {
