@@ -63,25 +63,24 @@ template <int W>
   }
 }
 
+// The kernel for the width, known at run time (1 to kMaxWidth).
+template <bool Forward, int... W>
+[[gnu::always_inline]] inline void dispatch(std::integer_sequence<int, W...>, const Columns& L,
+                                            const std::vector<int>& columns, double* x, int width) {
+  ((width == W + 1 ? (Forward ? forward<W + 1>(L, columns, x) : backward<W + 1>(L, columns, x))
+                   : void()),
+   ...);
+}
+
 // Compiled for AVX2 as well, chosen at run time: no -march flag is needed.
-template <bool Forward>
-__attribute__((target_clones("avx2", "default"))) void substitute_columns(
+__attribute__((target_clones("avx2", "default"))) void forward_columns(
     const Columns& L, const std::vector<int>& columns, double* x, int width) {
-  switch (width) {
-#define SPECDEFORM_WIDTH(W)                                           \
-  case W:                                                             \
-    Forward ? forward<W>(L, columns, x) : backward<W>(L, columns, x); \
-    break;
-    SPECDEFORM_WIDTH(1)
-    SPECDEFORM_WIDTH(2)
-    SPECDEFORM_WIDTH(3)
-    SPECDEFORM_WIDTH(4)
-    SPECDEFORM_WIDTH(5)
-    SPECDEFORM_WIDTH(6)
-    SPECDEFORM_WIDTH(7)
-    SPECDEFORM_WIDTH(8)
-#undef SPECDEFORM_WIDTH
-  }
+  dispatch<true>(std::make_integer_sequence<int, kMaxWidth>(), L, columns, x, width);
+}
+
+__attribute__((target_clones("avx2", "default"))) void backward_columns(
+    const Columns& L, const std::vector<int>& columns, double* x, int width) {
+  dispatch<false>(std::make_integer_sequence<int, kMaxWidth>(), L, columns, x, width);
 }
 
 }  // namespace
@@ -227,14 +226,14 @@ void TriangularSolver::solve_in_place(double* x, int width) const {
   const Columns L{start_.data(), row_.data(), value_.data(), inv_diagonal_.data()};
   std::fill_n(x + static_cast<size_t>(n_) * width, static_cast<size_t>(2 * slots_) * width, 0.0);
   if (forest_[1].empty() && separator_.empty()) {
-    substitute_columns<true>(L, forest_[0], x, width);
-    substitute_columns<false>(L, forest_[0], x, width);
+    forward_columns(L, forest_[0], x, width);
+    backward_columns(L, forest_[0], x, width);
     return;
   }
   const auto row = [&](int i) { return x + static_cast<size_t>(i) * width; };
   std::barrier sync(2);
   const auto work = [&](int t) {
-    substitute_columns<true>(L, forest_[t], x, width);
+    forward_columns(L, forest_[t], x, width);
     sync.arrive_and_wait();
     if (t == 0) {
       for (int s = 0; s < slots_; ++s) {
@@ -243,8 +242,8 @@ void TriangularSolver::solve_in_place(double* x, int width) const {
         const double* b = row(n_ + slots_ + s);
         for (int k = 0; k < width; ++k) xs[k] += a[k] + b[k];
       }
-      substitute_columns<true>(L, separator_, x, width);
-      substitute_columns<false>(L, separator_, x, width);
+      forward_columns(L, separator_, x, width);
+      backward_columns(L, separator_, x, width);
       for (int s = 0; s < slots_; ++s) {
         const double* xs = row(separator_[s]);
         std::copy(xs, xs + width, row(n_ + s));
@@ -252,7 +251,7 @@ void TriangularSolver::solve_in_place(double* x, int width) const {
       }
     }
     sync.arrive_and_wait();
-    substitute_columns<false>(L, forest_[t], x, width);
+    backward_columns(L, forest_[t], x, width);
   };
   run_pair([&] { work(0); }, [&] { work(1); });
 }
