@@ -13,7 +13,6 @@
 #include <nlohmann/json.hpp>
 
 #include "common.h"
-#include "specdeform/atomic_file.h"
 #include "specdeform/deform/scene.h"
 #include "specdeform/deform/spectral_deformer.h"
 #include "specdeform/exceptions.h"
@@ -118,7 +117,7 @@ void add_bench_command(CLI::App& app) {
     std::vector<int> modes{100};
     int repeat = 21;
     bool quick = false;
-    std::string json, markdown;
+    TableOutputs tables;
     ManifoldHarmonicsOptions harmonics;
   };
   auto args = std::make_shared<Args>();
@@ -133,8 +132,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--repeat", args->repeat, "frames per median (default 21)")
       ->check(CLI::Range(1, 100000));
   cmd->add_flag("--quick", args->quick, "small generated meshes, a few seconds (for tests)");
-  cmd->add_option("--json", args->json, "write the rows as JSON to this file");
-  cmd->add_option("--markdown", args->markdown, "write a markdown table to this file");
+  args->tables.add_to(*cmd);
   add_harmonics_options(*cmd, args->harmonics);
   cmd->callback([args] {
     std::vector<std::pair<std::string, TriangleMesh>> meshes;
@@ -163,9 +161,7 @@ void add_bench_command(CLI::App& app) {
       }
     }
     const std::string table = markdown(rows);
-    if (!args->json.empty()) write_file_atomically(args->json, rows.dump(2) + "\n");
-    if (!args->markdown.empty()) write_file_atomically(args->markdown, table);
-    std::cout << table;
+    args->tables.write(rows, table);
   });
 }
 

@@ -11,7 +11,6 @@
 #include <nlohmann/json.hpp>
 
 #include "common.h"
-#include "specdeform/atomic_file.h"
 #include "specdeform/deform/spectral_deformer.h"
 #include "specdeform/mesh/surface_distance.h"
 #include "specdeform/operators/mass_matrix.h"
@@ -38,7 +37,8 @@ void add_converge_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "converge", "deform one scene with several m and compare (the paper's Fig. 6)");
   struct Args {
-    std::string mesh, output, json, markdown;
+    std::string mesh, output;
+    TableOutputs tables;
     SceneArgs scene;
     std::vector<int> modes{50, 100, 200, 300, 500, 900};
     DeformOptions options;
@@ -50,8 +50,7 @@ void add_converge_command(CLI::App& app) {
   cmd->add_option("-m,--modes", args->modes, "frequencies to compare (default 50 ... 900)")
       ->check(CLI::Range(1, 100000));
   cmd->add_option("-o,--output", args->output, "folder for the deformed meshes (optional)");
-  cmd->add_option("--json", args->json, "write the rows as JSON to this file");
-  cmd->add_option("--markdown", args->markdown, "write a markdown table to this file");
+  args->tables.add_to(*cmd);
   add_harmonics_options(*cmd, args->harmonics);
   cmd->callback([args] {
     const LoadedScene s = load_scene(args->mesh, args->scene, args->options);
@@ -129,9 +128,7 @@ void add_converge_command(CLI::App& app) {
                " | " + number(base_rms) + " | " + number(base_max) + " | " + number(spatial_error) +
                " |\n";
     }
-    if (!args->json.empty()) write_file_atomically(args->json, rows.dump(2) + "\n");
-    if (!args->markdown.empty()) write_file_atomically(args->markdown, table);
-    std::cout << table;
+    args->tables.write(rows, table);
   });
 }
 

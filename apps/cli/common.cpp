@@ -9,6 +9,7 @@
 #include <iostream>
 #include <map>
 
+#include "specdeform/atomic_file.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/spectral/basis_cache.h"
 
@@ -101,6 +102,17 @@ void add_harmonics_options(CLI::App& cmd, ManifoldHarmonicsOptions& o) {
       ->check(kNonNegative);
   cmd.add_option("--block-size", o.block_size, "right-hand sides per solve (default: automatic)")
       ->check(kNonNegative);
+}
+
+void TableOutputs::add_to(CLI::App& cmd) {
+  cmd.add_option("--json", json, "write the rows as JSON to this file");
+  cmd.add_option("--markdown", markdown, "write a markdown table to this file");
+}
+
+void TableOutputs::write(const nlohmann::ordered_json& rows, const std::string& table) const {
+  if (!json.empty()) write_file_atomically(json, rows.dump(2) + "\n");
+  if (!markdown.empty()) write_file_atomically(markdown, table);
+  std::cout << table;
 }
 
 void SceneArgs::add_to(CLI::App& cmd) {

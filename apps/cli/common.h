@@ -7,6 +7,7 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "specdeform/deform/scene.h"
 #include "specdeform/deform/spectral_deformer.h"
@@ -40,6 +41,14 @@ ManifoldHarmonics obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonics
                                const std::string& cache, bool* loaded = nullptr);
 
 // The handle options shared by deform and converge: --sel/--dmat with --def, or --scene.
+// --json FILE and --markdown FILE: a table's rows as JSON and as markdown; write() also prints
+// the markdown on stdout.
+struct TableOutputs {
+  std::string json, markdown;
+  void add_to(CLI::App& cmd);
+  void write(const nlohmann::ordered_json& rows, const std::string& table) const;
+};
+
 struct SceneArgs {
   std::string sel, def, dmat, scene;
   void add_to(CLI::App& cmd);
