@@ -31,6 +31,7 @@ class AnchoredPoisson {
   // Throws SolverError if the system is singular (a component without anchors).
   void set_anchors(const std::vector<int>& anchors);
 
+  const Eigen::SparseMatrix<double>& stiffness() const { return K_; }
   // The factor's ordering: its row k is vertex order()[k].
   const std::vector<int>& order() const { return order_; }
   // Solves in place, in the factor's ordering: see TriangularSolver::solve_in_place (width 3).

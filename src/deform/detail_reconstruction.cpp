@@ -59,8 +59,8 @@ struct DetailReconstruction::Poisson {
   Eigen::SparseMatrix<double, Eigen::RowMajor> edges;    // n x n, compressed
   Eigen::SparseMatrix<double, Eigen::RowMajor> normals;  // n x faces, compressed
   RowMajor constant;                                     // n x 3
-  Sparse K;                                              // cotangent stiffness of the detailed mesh
-  Sparse coupling;           // n x n': K's columns of the anchors, anchor rows zeroed
+  Sparse coupling;           // n x n': K's columns of the anchors, anchor rows zeroed (rows
+                             // numbered as the factor)
   std::vector<int> anchors;  // the anchors' rows
   std::unique_ptr<detail::AnchoredPoisson> system;
   std::vector<int> order;  // row k is vertex order[k] of the mesh
@@ -150,16 +150,10 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
       const Eigen::MatrixX3d J = G * detailed.V;  // rows 3f..3f+2: gradients of x, y, z
       const int nf = detailed.num_faces();
       const int n = detailed.num_vertices();
-      Eigen::PermutationMatrix<Eigen::Dynamic> to_rows(n);
-      {
-        const Sparse K = cotan_stiffness(detailed);
-        p.system = std::make_unique<detail::AnchoredPoisson>(K);
-        p.order = p.system->order();
-        p.rank.resize(n);
-        for (int k = 0; k < n; ++k) p.rank[p.order[k]] = k;
-        for (int i = 0; i < n; ++i) to_rows.indices()[i] = p.rank[i];
-        p.K = K.twistedBy(to_rows);
-      }
+      p.system = std::make_unique<detail::AnchoredPoisson>(cotan_stiffness(detailed));
+      p.order = p.system->order();
+      p.rank.resize(n);
+      for (int k = 0; k < n; ++k) p.rank[p.order[k]] = k;
       std::vector<int> face_order(nf), first(nf);
       for (int f = 0; f < nf; ++f) {
         face_order[f] = f;
@@ -213,16 +207,20 @@ void DetailReconstruction::set_anchors(const std::vector<int>& vertices) {
   Poisson& p = *poisson_;
   p.anchors.resize(vertices.size());
   for (size_t i = 0; i < vertices.size(); ++i) p.anchors[i] = p.rank[vertices[i]];
-  std::vector<char> anchored(p.K.rows(), 0);
-  for (const int v : p.anchors) anchored[v] = 1;
+  const int n = static_cast<int>(p.order.size());
+  std::vector<char> anchored(n, 0);
+  for (const int v : vertices) anchored[v] = 1;
   p.system->set_anchors(vertices);
+  const Sparse& K = p.system->stiffness();  // in the mesh's numbering
   std::vector<Eigen::Triplet<double>> coupling;
-  for (size_t i = 0; i < p.anchors.size(); ++i) {
-    for (Sparse::InnerIterator it(p.K, p.anchors[i]); it; ++it) {
-      if (!anchored[it.row()]) coupling.emplace_back(it.row(), static_cast<int>(i), it.value());
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    for (Sparse::InnerIterator it(K, vertices[i]); it; ++it) {
+      if (!anchored[it.row()]) {
+        coupling.emplace_back(p.rank[it.row()], static_cast<int>(i), it.value());
+      }
     }
   }
-  p.coupling.resize(p.K.rows(), static_cast<int>(vertices.size()));
+  p.coupling.resize(n, static_cast<int>(vertices.size()));
   p.coupling.setFromTriplets(coupling.begin(), coupling.end());
 }
 
