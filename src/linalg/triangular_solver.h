@@ -38,7 +38,6 @@ class TriangularSolver {
   int workspace_rows() const { return n_ + 2 * slots_; }
   const std::vector<int>& order() const { return order_; }
 
-  Eigen::Index rows() const { return n_; }
   // Share of the factor's entries in the separator, solved on one thread (0 when the whole
   // factor is solved on one thread).
   double separator_share() const { return separator_share_; }
