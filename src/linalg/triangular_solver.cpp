@@ -257,9 +257,16 @@ void TriangularSolver::solve_in_place(double* x, int width) const {
 }
 
 Eigen::MatrixXd TriangularSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& B) const {
+  Eigen::MatrixXd X;
+  std::vector<double> workspace;
+  solve(B, X, workspace);
+  return X;
+}
+
+void TriangularSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::MatrixXd& X,
+                             std::vector<double>& x) const {
   if (B.rows() != n_) throw InputError("triangular solve: right-hand side of the wrong size");
-  Eigen::MatrixXd X(n_, B.cols());
-  std::vector<double> x;
+  X.resize(n_, B.cols());
   for (Eigen::Index c0 = 0; c0 < B.cols(); c0 += kMaxWidth) {
     const int width = static_cast<int>(std::min<Eigen::Index>(kMaxWidth, B.cols() - c0));
     x.resize(static_cast<size_t>(workspace_rows()) * width);
@@ -269,7 +276,6 @@ Eigen::MatrixXd TriangularSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>&
     for (int k = 0; k < n_; ++k)
       for (int c = 0; c < width; ++c) X(order_[k], c0 + c) = x[static_cast<size_t>(k) * width + c];
   }
-  return X;
 }
 
 }  // namespace specdeform::detail

@@ -30,6 +30,9 @@ class TriangularSolver {
 
   // A^-1 B for B n x k, any k.
   Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& B) const;
+  // The same into X, with scratch memory `workspace`: neither is reallocated when its size fits.
+  void solve(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::MatrixXd& X,
+             std::vector<double>& workspace) const;
 
   // In place, without the permutation: x is row-major, workspace_rows() x width (1 to 8), and
   // its first n rows hold the right-hand side in the factor's order (row k: unknown order()[k])

@@ -17,6 +17,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
 
+#include "linalg/basis_sweep.h"
 #include "linalg/parallel.h"
 #include "linalg/triangular_solver.h"
 #include "specdeform/exceptions.h"
@@ -29,6 +30,7 @@ namespace {
 using Mat = Eigen::MatrixXd;
 using Vec = Eigen::VectorXd;
 using Sparse = Eigen::SparseMatrix<double>;
+using detail::RowMatrix;
 
 // Meshes this small (or bases this close to complete) are solved densely.
 constexpr int kDenseLimit = 1200;
@@ -48,8 +50,17 @@ class MassOperator {
     if (diagonal_) return d_.asDiagonal() * X;
     return M_ * X;
   }
+  // out = M X, in out's memory.
+  void apply(const Mat& X, Mat& out) const {
+    if (diagonal_) {
+      out.noalias() = d_.asDiagonal() * X;
+    } else {
+      out.noalias() = M_ * X;
+    }
+  }
   // X^T M X; for a diagonal M in blocks of rows, without an n x k temporary.
-  Mat gram(const Mat& X) const {
+  template <typename Derived>
+  Mat gram(const Eigen::MatrixBase<Derived>& X) const {
     if (!diagonal_) return X.transpose() * (M_ * X);
     constexpr Eigen::Index kRows = 4096;
     Mat G = Mat::Zero(X.cols(), X.cols());
@@ -59,6 +70,24 @@ class MassOperator {
       G.noalias() += block.transpose() * (d_.segment(r, rows).asDiagonal() * block);
     }
     return G;
+  }
+  // The M-norm of each column of X.
+  Vec norms(const Mat& X) const {
+    if (!diagonal_) return (M_ * X).cwiseProduct(X).colwise().sum().cwiseMax(0.0).cwiseSqrt();
+    return (X.array().square().colwise() * d_.array()).colwise().sum().cwiseMax(0.0).sqrt();
+  }
+  // X -= V D (when D is given), then P = V^T M X and G = X^T M X (those given), V's first k
+  // columns: one pass over V for a lumped mass (linalg/basis_sweep.h).
+  void project(const RowMatrix& V, Eigen::Index k, RowMatrix& X, const RowMatrix* D, RowMatrix* P,
+               RowMatrix* G) const {
+    if (diagonal_) {
+      detail::sweep_basis(V, k, X, {.subtract = D, .weights = &d_, .projection = P, .gram = G});
+      return;
+    }
+    if (D != nullptr) detail::sweep_basis(V, k, X, {.subtract = D});
+    if (P == nullptr && G == nullptr) return;
+    const RowMatrix Y = M_ * X;
+    detail::sweep_basis(V, k, X, {.weighted = &Y, .projection = P, .gram = G});
   }
   const Sparse& matrix() const { return M_; }
 
@@ -105,18 +134,22 @@ class ShiftInvert {
     cholmod_finish(&common);
     if (ok_ && !definite()) {
       const Mat b = random_block(static_cast<int>(S_.rows()), 1, rng);
-      const Mat x = solve(b);
+      Mat x;
+      solve(b, x);
       ok_ = x.allFinite() && (b - S_ * x).norm() <= 1e-10 * b.norm();
     }
   }
   bool usable() const { return ok_; }
-  // LDL^T of an indefinite matrix is computed without pivoting; one step of iterative
-  // refinement brings its solves from ~1e-10 back to round-off, which the Krylov relation needs.
-  Mat solve(const Mat& B) const {
-    if (definite()) return solver_.solve(B);
-    Mat X = solver_.solve(B);
-    X += solver_.solve(B - S_ * X);
-    return X;
+  // X = (K - sigma M)^-1 B, in X's memory. LDL^T of an indefinite matrix is computed without
+  // pivoting; one step of iterative refinement brings its solves from ~1e-10 back to round-off,
+  // which the Krylov relation needs.
+  void solve(const Mat& B, Mat& X) {
+    solver_.solve(B, X, workspace_);
+    if (definite()) return;
+    residual_ = B;
+    residual_.noalias() -= S_ * X;
+    solver_.solve(residual_, correction_, workspace_);
+    X += correction_;
   }
   double sigma() const { return sigma_; }
 
@@ -126,49 +159,63 @@ class ShiftInvert {
   Sparse S_;
   bool ok_ = false;
   detail::TriangularSolver solver_;
+  std::vector<double> workspace_;
+  Mat residual_, correction_;
 };
 
-Vec m_norms(const Mat& X, const MassOperator& M) {
-  return M.apply(X).cwiseProduct(X).colwise().sum().cwiseMax(0.0).cwiseSqrt().transpose();
-}
-
-// Cholesky QR, twice (Fukaya et al. 2014): W := W R^-1 with R^T R = W^T M W. BLAS-3; accurate
-// when W is not too ill-conditioned, false (W spanning the same space) where it is.
-bool cholesky_qr2(Mat& W, const MassOperator& M) {
+// Cholesky QR, twice (Fukaya et al. 2014): per pass W := W U^-1 with U^T U = W^T M W, and
+// R := U R, so that W R stays the same. `gram` is W^T M W where already known. BLAS-3; accurate
+// when W is not too ill-conditioned, false (W R still the same) where it is.
+template <typename Derived>
+bool cholesky_qr2(const Eigen::MatrixBase<Derived>& block, const MassOperator& M, Mat& R,
+                  Mat gram = Mat()) {
+  auto& W = const_cast<Eigen::MatrixBase<Derived>&>(block);  // Eigen's idiom for writable blocks
   for (int pass = 0; pass < 2; ++pass) {
-    const Mat G = M.gram(W);
-    const Eigen::LLT<Mat> llt(0.5 * (G + G.transpose()));
+    if (pass > 0 || gram.size() == 0) gram = M.gram(W);
+    const Eigen::LLT<Mat> llt(0.5 * (gram + gram.transpose()));
     if (llt.info() != Eigen::Success) return false;
     const Vec r = llt.matrixLLT().diagonal();
     if (!(r.minCoeff() > 1e-6 * r.maxCoeff())) return false;
     llt.matrixU().solveInPlace<Eigen::OnTheRight>(W);
+    R = Mat(llt.matrixU()) * R;
   }
   return true;
 }
 
-// Makes the columns of W M-orthonormal and M-orthogonal to the columns of each basis in `against`
-// (each M-orthonormal): block classical Gram-Schmidt against the bases (BLAS-3), repeated only
-// when it cancelled most of a column (Kahan-Parlett "twice is enough"), then Cholesky QR within
-// the block, or Gram-Schmidt where W is ill-conditioned. A column that vanishes is replaced by a
-// random one.
+bool cholesky_qr2(Mat& W, const MassOperator& M) {
+  Mat R = Mat::Identity(W.cols(), W.cols());
+  return cholesky_qr2(W, M, R);
+}
+
 using Basis = Eigen::Ref<const Mat>;
 
+// Makes the columns of W M-orthogonal to the columns of each basis in `against` (each
+// M-orthonormal): block classical Gram-Schmidt (BLAS-3), repeated only when it cancelled most of
+// a column (Kahan-Parlett "twice is enough").
+void project_out(Mat& W, std::initializer_list<Basis> against, const MassOperator& M) {
+  if (std::all_of(against.begin(), against.end(), [](const Basis& B) { return B.cols() == 0; }))
+    return;
+  Vec before = M.norms(W);
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const Basis& B : against) {  // B^T M W, with M applied to the thinner of the two
+      if (B.cols() == 0) continue;
+      const Mat C =
+          B.cols() < W.cols() ? Mat(M.apply(B).transpose() * W) : Mat(B.transpose() * M.apply(W));
+      W.noalias() -= B * C;
+    }
+    const Vec after = M.norms(W);
+    if ((after.array() > 0.5 * before.array()).all()) break;
+    before = after;
+  }
+}
+
+// Makes the columns of W M-orthonormal and M-orthogonal to the bases in `against`: project_out,
+// then Cholesky QR within the block, or Gram-Schmidt where W is ill-conditioned. A column that
+// vanishes is replaced by a random one.
 void orthonormalize(Mat& W, std::initializer_list<Basis> against, const MassOperator& M,
                     std::mt19937_64& rng) {
-  const bool alone =
-      std::all_of(against.begin(), against.end(), [](const Basis& B) { return B.cols() == 0; });
-  if (alone && cholesky_qr2(W, M)) return;
   for (int attempt = 0; attempt < 3; ++attempt) {
-    Vec before = m_norms(W, M);
-    for (int pass = 0; pass < 2; ++pass) {
-      const Mat MW = M.apply(W);
-      for (const Basis& B : against) {
-        if (B.cols() > 0) W.noalias() -= B * (B.transpose() * MW);
-      }
-      const Vec after = m_norms(W, M);
-      if ((after.array() > 0.5 * before.array()).all()) break;
-      before = after;
-    }
+    project_out(W, against, M);
     if (cholesky_qr2(W, M)) return;
     bool replaced = false;
     for (int j = 0; j < W.cols(); ++j) {
@@ -208,7 +255,8 @@ struct BandSettings {
 
 // Replaces the first k columns of V by V[:, :k] Z (k x c), c <= k, in place, a block of rows at a
 // time, so that no second n x k buffer is needed.
-void multiply_in_place(Mat& V, int k, const Mat& Z) {
+template <typename Matrix>
+void multiply_in_place(Matrix& V, Eigen::Index k, const Mat& Z) {
   constexpr int kRows = 2048;
   Mat chunk;
   for (Eigen::Index r = 0; r < V.rows(); r += kRows) {
@@ -226,49 +274,66 @@ void multiply_in_place(Mat& V, int k, const Mat& Z) {
 //     A V = V T + Q F^T,    V^T M V = I,  Q^T M Q = I,  V^T M Q = 0,
 // so Ritz pairs (theta, y = V z) of T have the residual A y - theta y = Q F^T z for free, and
 // A y / theta = y + Q F^T z / theta is one step of inverse iteration, also for free.
-BandResult solve_band(const ShiftInvert& op, const MassOperator& M, const Basis& found,
-                      const Basis& near, const BandSettings& set, std::mt19937_64& rng) {
+BandResult solve_band(ShiftInvert& op, const MassOperator& M, const Basis& found, const Basis& near,
+                      const BandSettings& set, std::mt19937_64& rng) {
   const int n = static_cast<int>(M.matrix().rows());
   const int b = set.block, s = set.subspace;
+  const int width = (b + 7) / 8 * 8;  // basis_sweep's blocks: a multiple of 8 columns
   const double sigma = op.sigma();
-  Mat V(n, s);
+  RowMatrix V(n, s);
   Mat T(0, 0), F(0, b);
   int k = 0;
   Mat Q = random_block(n, b, rng);
   orthonormalize(Q, {found}, M, rng);
   BandResult out;
+  // Buffers kept from step to step: no page faults for large meshes.
+  RowMatrix X = RowMatrix::Zero(n, width), D1, D2, gram;
+  Mat MQ, W;
   for (;;) {
     while (k + b <= s) {
       V.middleCols(k, b) = Q;
-      Mat W = op.solve(M.apply(Q));
+      M.apply(Q, MQ);
+      op.solve(MQ, W);
       out.solves += b;
-      // W = V C + Q' R: block Gram-Schmidt (twice), then within the block.
-      Mat C = Mat::Zero(k + b, b);
-      for (int pass = 0; pass < 2; ++pass) {
-        const Mat D = V.leftCols(k + b).transpose() * M.apply(W);
-        W.noalias() -= V.leftCols(k + b) * D;
-        C += D;
+      // W = V C + Q' R: block classical Gram-Schmidt against V, twice, each pass's subtraction
+      // fused with the next one's projection; then Cholesky QR within the block.
+      X.leftCols(b) = W;
+      M.project(V, k + b, X, nullptr, &D1, nullptr);
+      M.project(V, k + b, X, &D1, &D2, nullptr);
+      M.project(V, k + b, X, &D2, nullptr, near.cols() > 0 ? nullptr : &gram);
+      const Mat C = (D1 + D2).leftCols(b);
+      if (near.cols() > 0) {
+        W = X.leftCols(b);
+        project_out(W, {near}, M);
+        X.leftCols(b) = W;
+        gram = M.gram(X.leftCols(b));
       }
-      if (near.cols() > 0) W.noalias() -= near * (near.transpose() * M.apply(W));
-      Mat R = Mat::Zero(b, b);
-      for (int j = 0; j < b; ++j) {
-        const double norm0 = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
-        for (int pass = 0; pass < 2 && j > 0; ++pass) {
-          const Vec c = W.leftCols(j).transpose() * M.apply(W.col(j)).col(0);
-          W.col(j) -= W.leftCols(j) * c;
-          R.col(j).head(j) += c;
+      Mat R = Mat::Identity(b, b);
+      if (!cholesky_qr2(X.leftCols(b), M, R, gram.topLeftCorner(b, b))) {  // ill-conditioned
+        W = X.leftCols(b);
+        Mat Rg = Mat::Zero(b, b);
+        for (int j = 0; j < b; ++j) {
+          const double norm0 = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
+          for (int pass = 0; pass < 2 && j > 0; ++pass) {
+            const Vec c = W.leftCols(j).transpose() * M.apply(W.col(j)).col(0);
+            W.col(j) -= W.leftCols(j) * c;
+            Rg.col(j).head(j) += c;
+          }
+          const double norm = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
+          if (norm > 1e-10 * norm0 && norm > 0.0) {
+            Rg(j, j) = norm;
+            W.col(j) /= norm;
+          } else {  // invariant subspace found: continue with a fresh direction
+            Mat fresh = random_block(n, 1, rng);
+            orthonormalize(fresh, {found, Mat(V.leftCols(k + b)), W.leftCols(j)}, M, rng);
+            W.col(j) = fresh.col(0);
+            Rg.col(j).setZero();
+          }
         }
-        const double norm = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
-        if (norm > 1e-10 * norm0 && norm > 0.0) {
-          R(j, j) = norm;
-          W.col(j) /= norm;
-        } else {  // invariant subspace found: continue with a fresh direction
-          Mat fresh = random_block(n, 1, rng);
-          orthonormalize(fresh, {found, V.leftCols(k + b), W.leftCols(j)}, M, rng);
-          W.col(j) = fresh.col(0);
-          R.col(j).setZero();
-        }
+        X.leftCols(b) = W;
+        R = Rg * R;
       }
+      Q = X.leftCols(b);
       Mat Tn = Mat::Zero(k + b, k + b);
       Tn.topLeftCorner(k, k) = T;
       Tn.bottomLeftCorner(b, k) = F.transpose();
@@ -276,7 +341,6 @@ BandResult solve_band(const ShiftInvert& op, const MassOperator& M, const Basis&
       T = 0.5 * (Tn + Tn.transpose());
       F = Mat::Zero(k + b, b);
       F.bottomRows(b) = R.transpose();
-      Q = std::move(W);
       k += b;
     }
     Eigen::SelfAdjointEigenSolver<Mat> eig(T);
@@ -307,7 +371,7 @@ BandResult solve_band(const ShiftInvert& op, const MassOperator& M, const Basis&
       const int count = std::max(converged, std::min(set.wanted, keep));
       Mat G = V.leftCols(k) * Z.leftCols(count);
       G.noalias() += Q * (FZ.leftCols(count) * theta.head(count).cwiseInverse().asDiagonal());
-      orthonormalize(G, {found}, M, rng);
+      project_out(G, {found}, M);  // Rayleigh-Ritz makes G M-orthonormal
       out.H = std::move(G);
       out.lambda = (sigma + theta.head(count).cwiseInverse().array()).matrix();
       return out;
@@ -320,15 +384,15 @@ BandResult solve_band(const ShiftInvert& op, const MassOperator& M, const Basis&
   }
 }
 
-// Rayleigh-Ritz of (K, M) on the span of H: an M-orthonormal basis of eigenvector
-// approximations, sorted ascending.
+// Rayleigh-Ritz of (K, M) on the span of H (independent columns): an M-orthonormal basis of
+// eigenvector approximations, sorted ascending.
 void rayleigh_ritz(const Sparse& K, const MassOperator& M, Mat& H, Vec& lambda) {
   const Mat A = H.transpose() * (K * H);
-  const Mat B = H.transpose() * M.apply(H);
+  const Mat B = M.gram(H);
   Eigen::GeneralizedSelfAdjointEigenSolver<Mat> eig(0.5 * (A + A.transpose()),
                                                     0.5 * (B + B.transpose()));
   if (eig.info() != Eigen::Success) throw SolverError("Rayleigh-Ritz step failed");
-  H = H * eig.eigenvectors();
+  multiply_in_place(H, H.cols(), eig.eigenvectors());
   lambda = eig.eigenvalues();
 }
 
@@ -555,7 +619,7 @@ Spectrum solve_block_krylov(const Sparse& K, const Sparse& Mmat, int m,
     set.tolerance = o.tolerance;
     set.max_restarts = o.max_restarts;
     report(o, double(count) / m, "factorization");
-    const ShiftInvert op(K, Mmat, sigma, rng);
+    ShiftInvert op(K, Mmat, sigma, rng);
     ++out.bands;
     if (!op.usable()) {  // the shift sits on an eigenvalue: move it a little
       retry(sigma + 0.1 * spacing);
