@@ -47,14 +47,32 @@ template <int R>
   }
 }
 
+// out[c][q..q+7] += sum_r s[r][c] Y_{i+r}[q..q+7] for c < count (out: count x w, row-major).
+template <int R>
+[[gnu::always_inline]] inline void add_products(const Rows& a, Eigen::Index i, int q,
+                                                const double* const (&s)[R], int count,
+                                                double* out) {
+  Lanes y[R];
+  weighted_lanes<R>(a, i, q, y);
+  for (int c = 0; c < count; ++c) {
+    double* o = out + c * a.w + q;
+    Lanes sum;
+    load(sum, o);
+    for (int r = 0; r < R; ++r) sum += s[r][c] * y[r];
+    store(o, sum);
+  }
+}
+
 // R consecutive rows from i: V's rows are read once from memory, then reused from L1.
 template <int R>
 [[gnu::always_inline]] inline void sweep_rows(const Rows& a, Eigen::Index i) {
   const double* v[R];
   double* x[R];
+  const double* x_read[R];
   for (int r = 0; r < R; ++r) {
     v[r] = a.V + (i + r) * a.ldv;
     x[r] = a.X + (i + r) * a.w;
+    x_read[r] = x[r];
   }
   for (int q = 0; q < a.w; q += kLanes) {
     if (a.D != nullptr) {
@@ -67,30 +85,10 @@ template <int R>
       }
       for (int r = 0; r < R; ++r) store(x[r] + q, xs[r]);
     }
-    if (a.P != nullptr) {
-      Lanes y[R];
-      weighted_lanes<R>(a, i, q, y);
-      for (int c = 0; c < a.k; ++c) {
-        double* p = a.P + c * a.w + q;
-        Lanes sum;
-        load(sum, p);
-        for (int r = 0; r < R; ++r) sum += v[r][c] * y[r];
-        store(p, sum);
-      }
-    }
+    if (a.P != nullptr) add_products<R>(a, i, q, v, a.k, a.P);
   }
   if (a.G != nullptr) {
-    for (int q = 0; q < a.w; q += kLanes) {
-      Lanes y[R];
-      weighted_lanes<R>(a, i, q, y);
-      for (int c = 0; c < a.w; ++c) {
-        double* g = a.G + c * a.w + q;
-        Lanes sum;
-        load(sum, g);
-        for (int r = 0; r < R; ++r) sum += x[r][c] * y[r];
-        store(g, sum);
-      }
-    }
+    for (int q = 0; q < a.w; q += kLanes) add_products<R>(a, i, q, x_read, a.w, a.G);
   }
 }
 
