@@ -209,6 +209,31 @@ void project_out(Mat& W, std::initializer_list<Basis> against, const MassOperato
   }
 }
 
+// Gram-Schmidt of W's columns in order, each against the ones before it twice, then normalised:
+// W (before) = W (after) R, R upper triangular (overwritten). A column left with less than
+// `vanish` of its M-norm is handed to replace(j) instead (its column of R zero), which puts
+// another direction there.
+template <typename Replace>
+void column_gram_schmidt(Mat& W, const MassOperator& M, double vanish, Mat& R, Replace replace) {
+  R.setZero();
+  for (int j = 0; j < W.cols(); ++j) {
+    const double norm0 = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
+    for (int pass = 0; pass < 2 && j > 0; ++pass) {
+      const Vec c = W.leftCols(j).transpose() * M.apply(W.col(j)).col(0);
+      W.col(j) -= W.leftCols(j) * c;
+      R.col(j).head(j) += c;
+    }
+    const double norm = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
+    if (norm > vanish * norm0 && norm > 0.0) {
+      R(j, j) = norm;
+      W.col(j) /= norm;
+    } else {
+      R.col(j).setZero();
+      replace(j);
+    }
+  }
+}
+
 // Makes the columns of W M-orthonormal and M-orthogonal to the bases in `against`: project_out,
 // then Cholesky QR within the block, or Gram-Schmidt where W is ill-conditioned. A column that
 // vanishes is replaced by a random one.
@@ -218,20 +243,11 @@ void orthonormalize(Mat& W, std::initializer_list<Basis> against, const MassOper
     project_out(W, against, M);
     if (cholesky_qr2(W, M)) return;
     bool replaced = false;
-    for (int j = 0; j < W.cols(); ++j) {
-      const double norm0 = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
-      for (int pass = 0; pass < 2 && j > 0; ++pass) {
-        const Vec Mw = M.apply(W.col(j)).col(0);
-        W.col(j) -= W.leftCols(j) * (W.leftCols(j).transpose() * Mw);
-      }
-      const double norm = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
-      if (!(norm > 1e-8 * norm0)) {
-        W.col(j) = random_block(static_cast<int>(W.rows()), 1, rng);
-        replaced = true;
-      } else {
-        W.col(j) /= norm;
-      }
-    }
+    Mat R = Mat::Zero(W.cols(), W.cols());
+    column_gram_schmidt(W, M, 1e-8, R, [&](int j) {
+      W.col(j) = random_block(static_cast<int>(W.rows()), 1, rng);
+      replaced = true;
+    });
     if (!replaced) return;
   }
   throw SolverError("cannot extend the Krylov basis (the problem is smaller than the basis)");
@@ -306,30 +322,18 @@ BandResult solve_band(ShiftInvert& op, const MassOperator& M, const Basis& found
         W = X.leftCols(b);
         project_out(W, {near}, M);
         X.leftCols(b) = W;
-        gram = M.gram(X.leftCols(b));
+        gram = M.gram(W);
       }
       Mat R = Mat::Identity(b, b);
       if (!cholesky_qr2(X.leftCols(b), M, R, gram.topLeftCorner(b, b))) {  // ill-conditioned
         W = X.leftCols(b);
         Mat Rg = Mat::Zero(b, b);
-        for (int j = 0; j < b; ++j) {
-          const double norm0 = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
-          for (int pass = 0; pass < 2 && j > 0; ++pass) {
-            const Vec c = W.leftCols(j).transpose() * M.apply(W.col(j)).col(0);
-            W.col(j) -= W.leftCols(j) * c;
-            Rg.col(j).head(j) += c;
-          }
-          const double norm = std::sqrt(std::max(0.0, W.col(j).dot(M.apply(W.col(j)).col(0))));
-          if (norm > 1e-10 * norm0 && norm > 0.0) {
-            Rg(j, j) = norm;
-            W.col(j) /= norm;
-          } else {  // invariant subspace found: continue with a fresh direction
-            Mat fresh = random_block(n, 1, rng);
-            orthonormalize(fresh, {found, Mat(V.leftCols(k + b)), W.leftCols(j)}, M, rng);
-            W.col(j) = fresh.col(0);
-            Rg.col(j).setZero();
-          }
-        }
+        column_gram_schmidt(W, M, 1e-10, Rg, [&](int j) {
+          // invariant subspace found: continue with a fresh direction
+          Mat fresh = random_block(n, 1, rng);
+          orthonormalize(fresh, {found, Mat(V.leftCols(k + b)), W.leftCols(j)}, M, rng);
+          W.col(j) = fresh.col(0);
+        });
         X.leftCols(b) = W;
         R = Rg * R;
       }
