@@ -94,7 +94,7 @@ void AnchoredPoisson::set_anchors(const std::vector<int>& anchors) {
     anchored_ = std::move(next);
     factorize();
     factored_ = true;
-    solver_.assign(factor_, common_);
+    solver_.assign(factor_);
     return;
   }
   for (const int v : add) {
@@ -105,7 +105,7 @@ void AnchoredPoisson::set_anchors(const std::vector<int>& anchors) {
   if (common_->status != CHOLMOD_OK) {
     throw SolverError("deformation transfer: updating the Poisson factorisation failed");
   }
-  solver_.assign(factor_, common_);
+  solver_.assign(factor_);
 }
 
 }  // namespace specdeform::detail

@@ -51,7 +51,7 @@ class MassOperator {
     return M_ * X;
   }
   // out = M X, in out's memory.
-  void apply(const Mat& X, Mat& out) const {
+  void apply(const RowMatrix& X, RowMatrix& out) const {
     if (diagonal_) {
       out.noalias() = d_.asDiagonal() * X;
     } else {
@@ -125,7 +125,7 @@ class ShiftInvert {
           common.status == CHOLMOD_OK && factor->minor == factor->n;
     if (ok_) {
       try {
-        solver_.assign(factor, &common);
+        solver_.assign(factor);
       } catch (const SolverError&) {
         ok_ = false;
       }
@@ -133,8 +133,8 @@ class ShiftInvert {
     cholmod_free_factor(&factor, &common);
     cholmod_finish(&common);
     if (ok_ && !definite()) {
-      const Mat b = random_block(static_cast<int>(S_.rows()), 1, rng);
-      Mat x;
+      const RowMatrix b = random_block(static_cast<int>(S_.rows()), 1, rng);
+      RowMatrix x;
       solve(b, x);
       ok_ = x.allFinite() && (b - S_ * x).norm() <= 1e-10 * b.norm();
     }
@@ -143,7 +143,7 @@ class ShiftInvert {
   // X = (K - sigma M)^-1 B, in X's memory. LDL^T of an indefinite matrix is computed without
   // pivoting; one step of iterative refinement brings its solves from ~1e-10 back to round-off,
   // which the Krylov relation needs.
-  void solve(const Mat& B, Mat& X) {
+  void solve(const RowMatrix& B, RowMatrix& X) {
     solver_.solve(B, X, workspace_);
     if (definite()) return;
     residual_ = B;
@@ -160,7 +160,7 @@ class ShiftInvert {
   bool ok_ = false;
   detail::TriangularSolver solver_;
   std::vector<double> workspace_;
-  Mat residual_, correction_;
+  RowMatrix residual_, correction_;
 };
 
 // Cholesky QR, twice (Fukaya et al. 2014): per pass W := W U^-1 with U^T U = W^T M W, and
@@ -299,21 +299,23 @@ BandResult solve_band(ShiftInvert& op, const MassOperator& M, const Basis& found
   RowMatrix V(n, s);
   Mat T(0, 0), F(0, b);
   int k = 0;
-  Mat Q = random_block(n, b, rng);
-  orthonormalize(Q, {found}, M, rng);
+  Mat start = random_block(n, b, rng);
+  orthonormalize(start, {found}, M, rng);
+  RowMatrix Q = start;
   BandResult out;
-  // Buffers kept from step to step: no page faults for large meshes.
-  RowMatrix X = RowMatrix::Zero(n, width), D1, D2, gram;
-  Mat MQ, W;
+  // Buffers kept from step to step: no page faults for large meshes. Row-major: the solver's
+  // permutation then moves whole rows.
+  RowMatrix X = RowMatrix::Zero(n, width), D1, D2, gram, MQ, solved;
+  Mat W;
   for (;;) {
     while (k + b <= s) {
       V.middleCols(k, b) = Q;
       M.apply(Q, MQ);
-      op.solve(MQ, W);
+      op.solve(MQ, solved);
       out.solves += b;
       // W = V C + Q' R: block classical Gram-Schmidt against V, twice, each pass's subtraction
       // fused with the next one's projection; then Cholesky QR within the block.
-      X.leftCols(b) = W;
+      X.leftCols(b) = solved;
       M.project(V, k + b, X, nullptr, &D1, nullptr);
       M.project(V, k + b, X, &D1, &D2, nullptr);
       M.project(V, k + b, X, &D2, nullptr, near.cols() > 0 ? nullptr : &gram);
