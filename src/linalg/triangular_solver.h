@@ -64,7 +64,6 @@ class TriangularSolver {
   double separator_share() const { return separator_share_; }
 
  private:
-  void copy(const cholmod_factor_struct* factor);
   void read_supernodal(const cholmod_factor_struct* factor);
   void read_simplicial(const cholmod_factor_struct* factor);
   void split(bool parallel);
