@@ -44,7 +44,7 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
   column_of_ = std::move(column_of);
   columns_ = std::move(columns);
   weights_.resize(nc);
-  for (int i = 0; i < nc; ++i) weights_[i] = options_.constraint_weight * vertex_area_[vertices[i]];
+  for (int i = 0; i < nc; ++i) weights_[i] = weight(vertices[i]);
   if (options_.constraints == ConstraintMode::Soft) {
     // Update the normal matrix by the vertices that changed, or rebuild it when many did.
     if (rebuild) {
@@ -53,12 +53,12 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
     } else {
       const auto update = [&](const std::vector<int>& changed, double sign) {
         Eigen::MatrixXd H(changed.size(), m);
-        Eigen::VectorXd weight(changed.size());
+        Eigen::VectorXd w(changed.size());
         for (size_t i = 0; i < changed.size(); ++i) {
           H.row(i) = basis_.row(changed[i]);
-          weight[i] = sign * options_.constraint_weight * vertex_area_[changed[i]];
+          w[i] = sign * weight(changed[i]);
         }
-        normal_.noalias() += H.transpose() * weight.asDiagonal() * H;
+        normal_.noalias() += H.transpose() * w.asDiagonal() * H;
       };
       update(added, 1.0);
       update(removed, -1.0);

@@ -39,6 +39,9 @@ class ReducedSolver {
   const Eigen::VectorXd& hessian() const { return hessian_; }
 
  private:
+  // The soft constraint's weight of a vertex: constraint_weight times its (unit-scale) area.
+  double weight(int vertex) const { return options_.constraint_weight * vertex_area_[vertex]; }
+
   const Eigen::MatrixXd& basis_;
   Eigen::VectorXd vertex_area_;  // on the unit-area scale
   Eigen::VectorXd hessian_;
