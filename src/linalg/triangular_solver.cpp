@@ -196,18 +196,12 @@ void TriangularSolver::assign(const cholmod_factor* factor) {
   inv_diagonal_.resize(n_);
   // The buffers keep their memory from one factor to the next (no page faults on reuse).
   nodes_.clear();
-  parent_.clear();
-  if (factor->is_super) {
-    read_supernodal(factor);
-  } else {
-    read_simplicial(factor);
-  }
-  split(true);
+  split(factor->is_super ? read_supernodal(factor) : read_simplicial(factor), true);
 }
 
 // CHOLMOD's supernodes: a column-major block per supernode, its rows listed (the diagonal
 // block's first), L L^T scaled to L D L^T.
-void TriangularSolver::read_supernodal(const cholmod_factor* factor) {
+std::vector<int> TriangularSolver::read_supernodal(const cholmod_factor* factor) {
   const int* super = static_cast<const int*>(factor->super);
   const int* pi = static_cast<const int*>(factor->pi);
   const int* px = static_cast<const int*>(factor->px);
@@ -222,6 +216,7 @@ void TriangularSolver::read_supernodal(const cholmod_factor* factor) {
   int rows = 0;
   long values = 0;
   std::vector<double> scale;
+  std::vector<int> tree;
   std::vector<long> at;  // where block row r's values go (-1: a row of zeros, dropped)
   for (int s = 0; s < count; ++s) {
     const int first = super[s], width = super[s + 1] - first, block_rows = pi[s + 1] - pi[s];
@@ -258,15 +253,16 @@ void TriangularSolver::read_supernodal(const cholmod_factor* factor) {
     }
     node.rows_end = rows;
     nodes_.push_back(node);
-    parent_.push_back(parent < n_ ? node_of[parent] : -1);
+    tree.push_back(parent < n_ ? node_of[parent] : -1);
   }
   row_.resize(rows);
   value_.resize(values);
+  return tree;
 }
 
 // A simplicial factor's fundamental supernodes: column c + 1 joins column c's supernode when
 // it is c's parent in the elimination tree and c's other rows are exactly its rows.
-void TriangularSolver::read_simplicial(const cholmod_factor* factor) {
+std::vector<int> TriangularSolver::read_simplicial(const cholmod_factor* factor) {
   const int* Lp = static_cast<const int*>(factor->p);
   const int* Li = static_cast<const int*>(factor->i);
   const int* Lnz = static_cast<const int*>(factor->nz);
@@ -284,7 +280,7 @@ void TriangularSolver::read_simplicial(const cholmod_factor* factor) {
       if (Li[e] != c + 1 && mark[Li[e]] != c) return false;
     return true;
   };
-  std::vector<int> node_of(n_);
+  std::vector<int> node_of(n_), tree;
   row_.resize(factor->nzmax);
   value_.resize(factor->nzmax);
   int rows = 0;
@@ -324,17 +320,18 @@ void TriangularSolver::read_simplicial(const cholmod_factor* factor) {
     }
     node.rows_end = rows;
     nodes_.push_back(node);
-    parent_.push_back(parent[last]);  // a column for now, its supernode below
+    tree.push_back(parent[last]);  // a column for now, its supernode below
     first += width;
   }
-  for (int& p : parent_) p = p >= 0 ? node_of[p] : -1;
+  for (int& p : tree) p = p >= 0 ? node_of[p] : -1;
   row_.resize(rows);
   value_.resize(values);
+  return tree;
 }
 
 // Splits the largest subtree (moving its root into the separator) until no subtree holds much
 // of the work, then deals the subtrees to two threads, largest first, each to the lighter one.
-void TriangularSolver::split(bool parallel) {
+void TriangularSolver::split(const std::vector<int>& parent, bool parallel) {
   const int count = static_cast<int>(nodes_.size());
   for (auto& list : forest_) list.clear();
   separator_.clear();
@@ -348,7 +345,7 @@ void TriangularSolver::split(bool parallel) {
   std::vector<long> subtree(count, 0);
   for (int s = 0; s < count; ++s) {
     subtree[s] += own(s);
-    if (parent_[s] >= 0) subtree[parent_[s]] += subtree[s];
+    if (parent[s] >= 0) subtree[parent[s]] += subtree[s];
   }
   long total = 0;
   for (int s = 0; s < count; ++s) total += own(s);
@@ -359,17 +356,17 @@ void TriangularSolver::split(bool parallel) {
   }
   std::vector<int> first_child(count + 1, 0), children(count);  // children of s: CSR
   for (int s = 0; s < count; ++s)
-    if (parent_[s] >= 0) ++first_child[parent_[s] + 1];
+    if (parent[s] >= 0) ++first_child[parent[s] + 1];
   for (int s = 0; s < count; ++s) first_child[s + 1] += first_child[s];
   {
     std::vector<int> next(first_child.begin(), first_child.end() - 1);
     for (int s = 0; s < count; ++s)
-      if (parent_[s] >= 0) children[next[parent_[s]]++] = s;
+      if (parent[s] >= 0) children[next[parent[s]]++] = s;
   }
   using Candidate = std::pair<long, int>;  // (subtree work, root)
   std::priority_queue<Candidate> candidates;
   for (int s = 0; s < count; ++s)
-    if (parent_[s] < 0) candidates.emplace(subtree[s], s);
+    if (parent[s] < 0) candidates.emplace(subtree[s], s);
   std::vector<int> owner(count, -1);  // thread, or 2: separator
   long separator_work = 0;
   while (!candidates.empty()) {
@@ -390,7 +387,7 @@ void TriangularSolver::split(bool parallel) {
     load[t] += work;
   }
   for (int s = count - 1; s >= 0; --s) {  // a parent comes after its children
-    if (owner[s] < 0) owner[s] = owner[parent_[s]];
+    if (owner[s] < 0) owner[s] = owner[parent[s]];
   }
   // Every entry of L lies on the path from its column to the root, so a forest's supernode
   // reaches only its own forest and the separator (checked all the same): its separator rows
@@ -404,7 +401,7 @@ void TriangularSolver::split(bool parallel) {
     for (int e = nodes_[s].rows; e < nodes_[s].rows_end; ++e) {
       const int o = column_owner[row_[e]];
       if (o != owner[s] && o != 2) {  // not an elimination tree: one thread solves it all
-        split(false);
+        split(parent, false);
         return;
       }
     }

@@ -64,15 +64,16 @@ class TriangularSolver {
   double separator_share() const { return separator_share_; }
 
  private:
-  void read_supernodal(const cholmod_factor_struct* factor);
-  void read_simplicial(const cholmod_factor_struct* factor);
-  void split(bool parallel);
+  // Each fills nodes_, row_, value_ and inv_diagonal_, and returns the supernodes' elimination
+  // tree: the parent of each (-1: a root).
+  std::vector<int> read_supernodal(const cholmod_factor_struct* factor);
+  std::vector<int> read_simplicial(const cholmod_factor_struct* factor);
+  void split(const std::vector<int>& parent, bool parallel);
 
   int n_ = 0;
   std::vector<int> order_;            // factor row k is unknown order_[k]
   std::vector<double> inv_diagonal_;  // 1 / D
   std::vector<Supernode> nodes_;      // ascending columns: a child before its parent
-  std::vector<int> parent_;           // the supernodes' elimination tree (-1: a root)
   std::vector<int> row_;              // rows of the separator are remapped into each thread's
   std::vector<double> value_;         // copy of them: n + t * slots + slot
   std::vector<int> forest_[2];        // each thread's supernodes, ascending
