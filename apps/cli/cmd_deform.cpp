@@ -19,7 +19,7 @@ void add_deform_command(CLI::App& app) {
     SceneArgs scene;
     int modes = 100, repeat = 1;
     bool json = false;
-    DeformOptions options;
+    DeformArgs deform;
     ManifoldHarmonicsOptions harmonics;
   };
   auto args = std::make_shared<Args>();
@@ -28,19 +28,9 @@ void add_deform_command(CLI::App& app) {
   args->scene.add_to(*cmd);
   cmd->add_option("-m,--modes", args->modes, "manifold harmonics used (default 100)")
       ->check(CLI::Range(1, 1000000));
-  cmd->add_option("--ks", args->options.ks, "stretching weight (default 0)")->check(kNonNegative);
-  cmd->add_option("--kb", args->options.kb, "bending weight (default 1)")->check(kNonNegative);
-  cmd->add_option("--weight", args->options.constraint_weight,
-                  "soft-constraint weight (default 1e5)")
-      ->check(kPositive);
-  cmd->add_option("--detail", args->options.detail,
-                  "none | displacement | frames | transfer (default)")
-      ->transform(CLI::CheckedTransformer(kDetailNames, CLI::ignore_case));
-  cmd->add_option("--solver", args->options.solver, "spectral (default) | spatial (reference)")
-      ->transform(CLI::CheckedTransformer(kSolverNames, CLI::ignore_case));
-  cmd->add_option("--constraints", args->options.constraints, "soft (default) | hard")
-      ->transform(CLI::CheckedTransformer(kConstraintNames, CLI::ignore_case));
-  cmd->add_flag("--float32", args->options.float32_basis, "single-precision basis in the frame");
+  args->deform.add_to(*cmd);
+  cmd->add_flag("--float32", args->deform.options.float32_basis,
+                "single-precision basis in the frame");
   cmd->add_option("--basis", args->basis,
                   "basis cache: read if it exists (and matches the mesh), written otherwise");
   cmd->add_option("--repeat", args->repeat, "solve the frame N times, report medians (default 1)")
@@ -49,24 +39,19 @@ void add_deform_command(CLI::App& app) {
   add_harmonics_options(*cmd, args->harmonics);
   cmd->callback([args, cmd] {
     // The scene's settings override the defaults; options given on the command line win.
-    const LoadedScene loaded_scene = load_scene(args->mesh, args->scene, args->options);
+    const LoadedScene loaded_scene = load_scene(args->mesh, args->scene, args->deform.options);
     const LoadedMesh& loaded = loaded_scene.mesh;
     const Scene& scene = loaded_scene.scene;
     const Selection& selection = loaded_scene.selection;
-    DeformOptions options = args->options;
+    DeformOptions options = args->deform.merged(*cmd, scene.options);
+    options.float32_basis = args->deform.options.float32_basis;
+    options.validate();
     int modes = args->modes;
-    if (!args->scene.scene.empty()) {
-      const auto keep = [&](const char* flag, auto& field, const auto& from_scene) {
-        if (cmd->count(flag) == 0) field = from_scene;
-      };
-      keep("--ks", options.ks, scene.options.ks);
-      keep("--kb", options.kb, scene.options.kb);
-      keep("--weight", options.constraint_weight, scene.options.constraint_weight);
-      keep("--detail", options.detail, scene.options.detail);
-      keep("--solver", options.solver, scene.options.solver);
-      keep("--constraints", options.constraints, scene.options.constraints);
-      if (cmd->count("--modes") == 0 && scene.modes) modes = *scene.modes;
-    }
+    if (cmd->count("--modes") == 0 && scene.modes) modes = *scene.modes;
+
+    // Every check of the selection before the basis, which may take long.
+    const ConstrainedSet constrained =
+        constrained_set(selection, loaded.mesh, options.unconstrained, loaded.info.vertex_to_file);
 
     nlohmann::ordered_json timings;
     ManifoldHarmonics basis;
@@ -88,6 +73,7 @@ void add_deform_command(CLI::App& app) {
     write_mesh(args->output, to_file_order(loaded.info, result, loaded.mesh.F));
     const SetupTimings& s = deformer.setup_timings();
     const ConstraintError e = deformer.constraint_error(result);
+    const ArapReport& arap = deformer.arap_report();
     timings["reduced_system"] = s.reduced_system;
     timings["detail_factorization"] = s.detail_factorization;
     timings["selection"] = s.selection;
@@ -100,11 +86,16 @@ void add_deform_command(CLI::App& app) {
       j["vertices"] = loaded.mesh.num_vertices();
       j["modes"] = options.solver == DeformSolver::Spectral ? modes : 0;
       j["basis_cached"] = loaded_basis;
-      j["constrained_vertices"] = selection.fixed.size() + [&] {
-        size_t c = 0;
-        for (const auto& g : selection.handles) c += g.size();
-        return c;
-      }();
+      j["constrained_vertices"] = constrained.first_held;
+      j["held_pieces"] = constrained.held_pieces;
+      j["energy"] = name(options.energy);
+      if (options.energy == DeformEnergy::Arap) {
+        j["iterations"] = arap.iterations;
+        j["relative_energy_change"] = arap.relative_change;
+        j["tolerance"] = options.arap.tolerance;
+        j["converged"] = arap.converged;
+        j["clusters"] = deformer.rotation_clusters();
+      }
       j["timings"] = timings;
       j["constraint_error"] = {{"max", e.max}, {"rms", e.rms}};
       j["output"] = args->output;
@@ -112,7 +103,16 @@ void add_deform_command(CLI::App& app) {
     } else {
       std::cout << "wrote " << args->output << ": frame " << frame.total * 1e3
                 << " ms, constraint error max " << e.max << " rms " << e.rms
-                << " (of the bounding-box diagonal)\n";
+                << " (of the bounding-box diagonal)";
+      if (options.energy == DeformEnergy::Arap) {
+        std::cout << "; ARAP " << arap.iterations << " iterations, last relative energy change "
+                  << arap.relative_change << (arap.converged ? "" : " (not converged)");
+      }
+      if (constrained.held_pieces > 0) {
+        std::cout << "; " << constrained.held_pieces
+                  << " pieces without handle or fixed vertex held in place";
+      }
+      std::cout << "\n";
     }
   });
 }

@@ -29,6 +29,7 @@ void add_edit_command(CLI::App& app) {
     server::EditorConfig editor;
     double max_upload_mb = 256;
     bool no_cache = false;
+    DeformArgs deform;
   };
   auto args = std::make_shared<Args>();
   args->server.assets = SPECDEFORM_WEB_DIST;
@@ -39,15 +40,7 @@ void add_edit_command(CLI::App& app) {
   cmd->add_option("--port", args->server.port, "port (default 8080; 0: any free port)");
   cmd->add_option("-m,--modes", args->editor.modes, "manifold harmonics used (default 100)")
       ->check(CLI::Range(1, 5000));
-  cmd->add_option("--ks", args->editor.options.ks, "stretching weight (default 0)")
-      ->check(kNonNegative);
-  cmd->add_option("--kb", args->editor.options.kb, "bending weight (default 1)")
-      ->check(kNonNegative);
-  cmd->add_option("--detail", args->editor.options.detail,
-                  "none | displacement | frames | transfer (default)")
-      ->transform(CLI::CheckedTransformer(kDetailNames, CLI::ignore_case));
-  cmd->add_option("--constraints", args->editor.options.constraints, "soft (default) | hard")
-      ->transform(CLI::CheckedTransformer(kConstraintNames, CLI::ignore_case));
+  args->deform.add_to(*cmd);
   cmd->add_option("--cache-dir", args->editor.cache_dir,
                   "where bases are cached (default ~/.cache/specdeform)");
   cmd->add_flag("--no-cache", args->no_cache, "neither read nor write cached bases");
@@ -55,7 +48,9 @@ void add_edit_command(CLI::App& app) {
                   "largest mesh file the browser may send (default 256)")
       ->check(kPositive);
   cmd->add_option("--assets", args->server.assets, "the built editor (default: web/dist)");
-  cmd->callback([args] {
+  cmd->callback([args, cmd] {
+    args->editor.options = args->deform.merged(*cmd, server::editor_deform_options());
+    args->editor.options.validate();
     if (args->no_cache) args->editor.cache_dir.clear();
     args->server.max_message_bytes = static_cast<size_t>(args->max_upload_mb * (1 << 20));
     server::EditorServer editor(args->server, args->editor);

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <sstream>
 
 #include "specdeform/atomic_file.h"
 #include "specdeform/exceptions.h"
@@ -49,12 +50,61 @@ std::map<std::string, Mode> by_name(std::initializer_list<Mode> modes) {
 
 }  // namespace
 
-const std::map<std::string, DetailMethod> kDetailNames = by_name(
-    {DetailMethod::None, DetailMethod::Displacement, DetailMethod::Frames, DetailMethod::Transfer});
-const std::map<std::string, DeformSolver> kSolverNames =
-    by_name({DeformSolver::Spectral, DeformSolver::Spatial});
-const std::map<std::string, ConstraintMode> kConstraintNames =
-    by_name({ConstraintMode::Soft, ConstraintMode::Hard});
+void DeformArgs::add_to(CLI::App& cmd) {
+  static const auto kEnergies = by_name({DeformEnergy::Linear, DeformEnergy::Arap});
+  static const auto kDetails = by_name({DetailMethod::None, DetailMethod::Displacement,
+                                        DetailMethod::Frames, DetailMethod::Transfer});
+  static const auto kSolvers = by_name({DeformSolver::Spectral, DeformSolver::Spatial});
+  static const auto kConstraints = by_name({ConstraintMode::Soft, ConstraintMode::Hard});
+  const DeformOptions defaults;
+  const auto fallback = [](auto value) {
+    std::ostringstream s;
+    s << " (default " << value << ")";
+    return s.str();
+  };
+  cmd.add_option("--energy", options.energy,
+                 "linear (the paper's shell) | arap (as-rigid-as-possible)" +
+                     fallback(name(defaults.energy)))
+      ->transform(CLI::CheckedTransformer(kEnergies, CLI::ignore_case));
+  cmd.add_option(
+         "--iterations", options.arap.max_iterations,
+         "ARAP: at most this many iterations per frame" + fallback(defaults.arap.max_iterations))
+      ->check(CLI::Range(1, 1000000));
+  cmd.add_option("--clusters", options.arap.clusters,
+                 "ARAP: rotation clusters" + fallback(defaults.arap.clusters))
+      ->check(CLI::Range(1, 100000000));
+  cmd.add_option("--ks", options.ks, "linear: stretching weight" + fallback(defaults.ks))
+      ->check(kNonNegative);
+  cmd.add_option("--kb", options.kb, "linear: bending weight" + fallback(defaults.kb))
+      ->check(kNonNegative);
+  cmd.add_option("--weight", options.constraint_weight,
+                 "soft-constraint weight" + fallback(defaults.constraint_weight))
+      ->check(kPositive);
+  cmd.add_option("--detail", options.detail,
+                 "none | displacement | frames | transfer" + fallback(name(defaults.detail)))
+      ->transform(CLI::CheckedTransformer(kDetails, CLI::ignore_case));
+  cmd.add_option("--solver", options.solver,
+                 "spectral | spatial (the reference)" + fallback(name(defaults.solver)))
+      ->transform(CLI::CheckedTransformer(kSolvers, CLI::ignore_case));
+  cmd.add_option("--constraints", options.constraints,
+                 "soft | hard" + fallback(name(defaults.constraints)))
+      ->transform(CLI::CheckedTransformer(kConstraints, CLI::ignore_case));
+}
+
+DeformOptions DeformArgs::merged(const CLI::App& cmd, const DeformOptions& scene) const {
+  DeformOptions o = scene;
+  const auto flag = [&](const char* name) { return cmd.count(name) > 0; };
+  if (flag("--energy")) o.energy = options.energy;
+  if (flag("--iterations")) o.arap.max_iterations = options.arap.max_iterations;
+  if (flag("--clusters")) o.arap.clusters = options.arap.clusters;
+  if (flag("--ks")) o.ks = options.ks;
+  if (flag("--kb")) o.kb = options.kb;
+  if (flag("--weight")) o.constraint_weight = options.constraint_weight;
+  if (flag("--detail")) o.detail = options.detail;
+  if (flag("--solver")) o.solver = options.solver;
+  if (flag("--constraints")) o.constraints = options.constraints;
+  return o;
+}
 
 LoadedMesh load_mesh(const std::string& path) {
   LoadedMesh loaded = read_mesh(path);

@@ -21,10 +21,13 @@ extern const CLI::Validator kPositive;
 // Accepts a number >= 0.
 extern const CLI::Validator kNonNegative;
 
-// Option values of the deformation settings.
-extern const std::map<std::string, DetailMethod> kDetailNames;
-extern const std::map<std::string, DeformSolver> kSolverNames;
-extern const std::map<std::string, ConstraintMode> kConstraintNames;
+// The deformation settings' flags: --energy, --iterations, --clusters, --ks, --kb, --weight,
+// --detail, --solver, --constraints. merged(): a scene's settings where no flag was given.
+struct DeformArgs {
+  DeformOptions options;
+  void add_to(CLI::App& cmd);
+  DeformOptions merged(const CLI::App& cmd, const DeformOptions& scene) const;
+};
 
 // Reads a mesh; what the reader dropped or merged is reported on stderr.
 LoadedMesh load_mesh(const std::string& path);

@@ -49,7 +49,7 @@ struct EditorSession::State {
   int modes = 100;
   DeformOptions options;
   bool base_view = false;
-  ManifoldHarmonics basis;
+  std::shared_ptr<const ManifoldHarmonics> basis;
   double basis_seconds = 0.0;
   bool basis_from_cache = false;
   std::string warning;  // about the basis, shown to the user
@@ -159,24 +159,29 @@ void EditorSession::text_message(std::string_view message) {
     if (auto v = number("modes", 1, 5000)) modes = static_cast<int>(*v);
     if (auto v = number("ks", 0, 1e6)) o.ks = *v;
     if (auto v = number("kb", 0, 1e6)) o.kb = *v;
-    if (!(o.ks > 0 || o.kb > 0)) throw InputError("settings: ks and kb cannot both be 0");
+    if (auto v = word("energy")) o.energy = deform_energy_from_name(*v);
     if (auto v = word("detail")) o.detail = detail_method_from_name(*v);
     if (auto v = word("constraints")) o.constraints = constraint_mode_from_name(*v);
     if (auto v = word("view")) {
       if (*v != "detailed" && *v != "base") throw InputError("settings: view is detailed or base");
       base_view = *v == "base";
     }
+    try {
+      o.validate();
+    } catch (const InputError& e) {
+      throw InputError(std::string("settings: ") + e.what());
+    }
     if (modes >= s.loaded.mesh.num_vertices()) {
       throw InputError("settings: m must be below the vertex count (" +
                        std::to_string(s.loaded.mesh.num_vertices()) + ")");
     }
     const bool new_basis = modes != s.modes;
-    const bool new_deformer = new_basis || o.ks != s.options.ks || o.kb != s.options.kb ||
-                              o.detail != s.options.detail ||
+    const bool new_deformer = new_basis || o.energy != s.options.energy || o.ks != s.options.ks ||
+                              o.kb != s.options.kb || o.detail != s.options.detail ||
                               o.constraints != s.options.constraints;
     s.base_view = base_view;
     if (new_deformer) {
-      build(s.loaded, s.name, modes, o, new_basis ? nullptr : &s.basis);
+      build(s.loaded, s.name, modes, o, new_basis ? nullptr : s.basis);
       config_.modes = modes;  // meshes opened later start with these settings too
       config_.options = o;
       return;
@@ -218,7 +223,8 @@ void EditorSession::open(LoadedMesh mesh, std::string name) {
 }
 
 void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
-                          const DeformOptions& options, const ManifoldHarmonics* reuse_basis) {
+                          const DeformOptions& options,
+                          std::shared_ptr<const ManifoldHarmonics> reuse_basis) {
   cancelled_ = false;
   auto next = std::make_unique<State>();
   State& s = *next;
@@ -240,39 +246,40 @@ void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
       config_.cache_dir.empty()
           ? std::filesystem::path()
           : cache_file(config_.cache_dir, mesh.mesh, s.modes, MassType::Lumped);
-  if (reuse_basis != nullptr) {
-    s.basis = *reuse_basis;
+  const bool reused = reuse_basis != nullptr;
+  if (reused) {
+    s.basis = std::move(reuse_basis);
     s.basis_seconds = state_->basis_seconds;
     s.basis_from_cache = state_->basis_from_cache;
     s.warning = state_->warning;
   } else if (!cache.empty() && std::filesystem::exists(cache)) {
     report(0.0, "loading the basis");
-    s.basis = load_basis(cache, mesh.mesh);
+    s.basis = std::make_shared<const ManifoldHarmonics>(load_basis(cache, mesh.mesh));
     s.basis_from_cache = true;
   } else {
     ManifoldHarmonicsOptions o;
     o.num_modes = s.modes;
     o.progress = report;
-    s.basis = compute_manifold_harmonics(mesh.mesh, o);
-    if (s.basis.status != SolveStatus::Converged) {
+    auto basis = std::make_shared<ManifoldHarmonics>(compute_manifold_harmonics(mesh.mesh, o));
+    s.basis = basis;
+    if (basis->status != SolveStatus::Converged) {
       // Short of the tolerance but far below what a deformation can show (nearly degenerate
       // triangles limit the attainable accuracy): usable, with a warning; not cached.
-      if (!(s.basis.max_residual <= kUsableResidual)) {
+      if (!(basis->max_residual <= kUsableResidual)) {
         throw SolverError(name + ": the manifold harmonics did not converge: " +
-                          residual_summary(s.basis, o.tolerance));
+                          residual_summary(*basis, o.tolerance));
       }
-      s.warning =
-          "the basis is less accurate than asked: " + residual_summary(s.basis, o.tolerance);
+      s.warning = "the basis is less accurate than asked: " + residual_summary(*basis, o.tolerance);
     } else if (!cache.empty()) {
       try {
         std::filesystem::create_directories(cache.parent_path());
-        save_basis(cache, s.basis, mesh.mesh, BasisPrecision::Float64);
+        save_basis(cache, *basis, mesh.mesh, BasisPrecision::Float64);
       } catch (const std::exception& e) {
         std::cerr << "specdeform: warning: basis not cached: " << e.what() << "\n";
       }
     }
   }
-  if (reuse_basis == nullptr) s.basis_seconds = seconds_since(start);
+  if (!reused) s.basis_seconds = seconds_since(start);
   report(1.0, "factorizing");
   s.deformer.emplace(mesh.mesh, s.basis, s.options);
   s.loaded = std::move(mesh);
@@ -307,7 +314,8 @@ void EditorSession::send_state() {
                          {"diagonal", s.diagonal},
                          {"modes", s.modes},
                          {"settings",
-                          {{"ks", s.options.ks},
+                          {{"energy", name(s.options.energy)},
+                           {"ks", s.options.ks},
                            {"kb", s.options.kb},
                            {"detail", name(s.options.detail)},
                            {"constraints", name(s.options.constraints)},
@@ -315,7 +323,7 @@ void EditorSession::send_state() {
                          {"basis",
                           {{"seconds", s.basis_seconds},
                            {"source", s.basis_from_cache ? "cache" : "computed"},
-                           {"residual", s.basis.max_residual},
+                           {"residual", s.basis->max_residual},
                            {"warning", s.warning}}},
                          {"setup",
                           {{"reduced_system", t.reduced_system},

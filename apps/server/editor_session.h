@@ -5,8 +5,9 @@
 // Text messages (JSON objects with a "type"):
 //   browser -> server
 //     {"type": "hello"}                         resend the mesh and its state (a new connection)
-//     {"type": "settings", "modes": m, "ks": x, "kb": x, "detail": "none|displacement|frames|
-//      transfer", "constraints": "soft|hard", "view": "detailed|base"}   any subset
+//     {"type": "settings", "modes": m, "energy": "linear|arap", "ks": x, "kb": x,
+//      "detail": "none|displacement|frames|transfer", "constraints": "soft|hard",
+//      "view": "detailed|base"}   any subset
 //     {"type": "open_demo"}                     the built-in bumpy bar
 //     {"type": "export_mesh", "format": "obj|off|ply|stl"}   answered with a file message
 //     {"type": "export_scene"}                  the scene JSON of `specdeform deform --scene`
@@ -34,10 +35,12 @@
 namespace specdeform::server {
 
 // Solver settings of the editor: the library's, but frames with the basis in single precision
-// (twice as fast an inverse transform; a displacement error of about 1e-7 of itself).
+// (twice as fast an inverse transform; a displacement error of about 1e-7 of itself), and ARAP
+// starting from the previous frame (a drag moves the handle a little per frame).
 inline DeformOptions editor_deform_options() {
   DeformOptions o;
   o.float32_basis = true;
+  o.arap.warm_start = true;
   return o;
 }
 
@@ -83,7 +86,7 @@ class EditorSession {
   void solve_and_send();
   void send_state();
   void build(LoadedMesh mesh, std::string name, int modes, const DeformOptions& options,
-             const ManifoldHarmonics* reuse_basis);
+             std::shared_ptr<const ManifoldHarmonics> reuse_basis);
   void send_error(const std::string& message);
 
   EditorConfig config_;

@@ -2,23 +2,24 @@
 
 #include <string>
 
-#include <Eigen/Cholesky>
 #include <Eigen/LU>
+#include <Eigen/QR>
 
 #include "specdeform/exceptions.h"
 
 namespace specdeform {
 
-ReducedSolver::ReducedSolver(const Eigen::MatrixXd& basis, const Eigen::VectorXd& eigenvalues,
-                             const Eigen::VectorXd& vertex_area, double area,
+ReducedSolver::ReducedSolver(std::shared_ptr<const ManifoldHarmonics> basis,
+                             Eigen::VectorXd hessian, Eigen::VectorXd vertex_area,
                              const DeformOptions& options)
-    : basis_(basis), vertex_area_(vertex_area / area), options_(options) {
-  const Eigen::ArrayXd lambda = eigenvalues.array().max(0.0);  // -1e-14 is 0
-  hessian_ = (options.ks * lambda + options.kb * area * lambda.square()).matrix();
-}
+    : basis_(std::move(basis)),
+      hessian_(std::move(hessian)),
+      vertex_area_(std::move(vertex_area)),
+      options_(options) {}
 
 void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
-  const int m = static_cast<int>(basis_.cols());
+  const Eigen::MatrixXd& H = basis_->basis;
+  const int m = static_cast<int>(H.cols());
   const int nc = static_cast<int>(vertices.size());
   // H_C^T: columns of the previous selection are copied (contiguous), only new vertices'
   // rows are gathered from the basis.
@@ -26,16 +27,16 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
   for (int i = 0; i < nc; ++i) {
     const int v = vertices[i];
     if (column_of_.empty() || column_of_[v] < 0) {
-      columns.col(i) = basis_.row(v).transpose();
+      columns.col(i) = H.row(v).transpose();
     } else {
       columns.col(i) = columns_.col(column_of_[v]);
     }
   }
   std::vector<int> added, removed;
-  std::vector<int> column_of(basis_.rows(), -1);
+  std::vector<int> column_of(H.rows(), -1);
   for (int i = 0; i < nc; ++i) column_of[vertices[i]] = i;
   if (!column_of_.empty()) {
-    for (int v = 0; v < static_cast<int>(basis_.rows()); ++v) {
+    for (int v = 0; v < static_cast<int>(H.rows()); ++v) {
       if (column_of[v] >= 0 && column_of_[v] < 0) added.push_back(v);
       if (column_of[v] < 0 && column_of_[v] >= 0) removed.push_back(v);
     }
@@ -52,13 +53,13 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
       normal_.diagonal() += hessian_;
     } else {
       const auto update = [&](const std::vector<int>& changed, double sign) {
-        Eigen::MatrixXd H(changed.size(), m);
+        Eigen::MatrixXd rows(changed.size(), m);
         Eigen::VectorXd w(changed.size());
         for (size_t i = 0; i < changed.size(); ++i) {
-          H.row(i) = basis_.row(changed[i]);
+          rows.row(i) = H.row(changed[i]);
           w[i] = sign * weight(changed[i]);
         }
-        normal_.noalias() += H.transpose() * w.asDiagonal() * H;
+        normal_.noalias() += rows.transpose() * w.asDiagonal() * rows;
       };
       update(added, 1.0);
       update(removed, -1.0);
@@ -91,6 +92,7 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
   const Eigen::MatrixXd particular = Q1 * RPt.transpose().inverse();  // m x n'
   if (m == nc) {
     hard_ = particular;
+    hard_free_ = Eigen::MatrixXd::Zero(m, m);
     return;
   }
   const Eigen::MatrixXd DQ2 = hessian_.asDiagonal() * Q2;
@@ -99,27 +101,49 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
     throw SolverError("hard constraints: the energy does not determine the free modes");
   }
   hard_ = particular - Q2 * reduced.solve(DQ2.transpose() * particular);
+  hard_free_ = Q2 * reduced.solve(Q2.transpose());
 }
 
-Eigen::MatrixX3d ReducedSolver::solve(const Eigen::MatrixX3d& targets) const {
+ReducedSolver::Targets ReducedSolver::prepare(const Eigen::MatrixX3d& targets) const {
   if (targets.rows() != columns_.cols()) {
     throw InputError("deformation: targets for " + std::to_string(targets.rows()) +
                      " vertices, the selection has " + std::to_string(columns_.cols()));
   }
-  // Outer products and vector solves: no BLAS call, whose worker threads would spin on the
-  // second core while the rest of the frame needs it. Vertices that keep their place (the
-  // fixed ones, typically most) add nothing to the right-hand side.
-  if (options_.constraints == ConstraintMode::Soft) {
-    Eigen::MatrixX3d c = Eigen::MatrixX3d::Zero(columns_.rows(), 3);
-    for (Eigen::Index i = 0; i < targets.rows(); ++i) {
-      if (!targets.row(i).isZero(0.0)) {
-        c.noalias() += columns_.col(i) * (weights_[i] * targets.row(i));
-      }
-    }
-    for (int d = 0; d < 3; ++d) c.col(d) = soft_.solve(c.col(d));
-    return c;
+  Targets out;
+  if (options_.constraints == ConstraintMode::Hard) {
+    out.rhs = hard_.lazyProduct(targets);
+    return out;
   }
-  return hard_.lazyProduct(targets);
+  // Outer products: no BLAS call, whose worker threads would spin on the second core while the
+  // rest of the frame needs it. Vertices that keep their place (the fixed ones, typically most)
+  // add nothing.
+  out.rhs = Eigen::MatrixX3d::Zero(columns_.rows(), 3);
+  for (Eigen::Index i = 0; i < targets.rows(); ++i) {
+    if (!targets.row(i).isZero(0.0)) {
+      out.rhs.noalias() += columns_.col(i) * (weights_[i] * targets.row(i));
+      out.constant += weights_[i] * targets.row(i).squaredNorm();
+    }
+  }
+  return out;
+}
+
+Eigen::MatrixX3d ReducedSolver::solve(const Targets& targets, const Eigen::MatrixX3d& g) const {
+  if (options_.constraints == ConstraintMode::Hard) {
+    if (g.rows() == 0) return targets.rhs;
+    return targets.rhs + hard_free_.lazyProduct(g);
+  }
+  Eigen::MatrixX3d c = g.rows() == 0 ? targets.rhs : Eigen::MatrixX3d(targets.rhs + g);
+  for (int d = 0; d < 3; ++d) c.col(d) = soft_.solve(c.col(d));
+  return c;
+}
+
+double ReducedSolver::energy(const Targets& targets, const Eigen::MatrixX3d& c) const {
+  if (options_.constraints == ConstraintMode::Hard) {
+    return (c.array().square().colwise() * hessian_.array()).sum();
+  }
+  // D + w H_C^T W H_C is the normal matrix: tr(c^T N c) - 2 tr(c^T rhs) + constant.
+  const Eigen::MatrixX3d Nc = normal_.lazyProduct(c);  // no BLAS call, as above
+  return (c.array() * (Nc - 2.0 * targets.rhs).array()).sum() + targets.constant;
 }
 
 }  // namespace specdeform

@@ -7,15 +7,20 @@
 
 namespace specdeform {
 
-ConstrainedSet constrained_set(const Selection& selection, const TriangleMesh& mesh) {
+ConstrainedSet constrained_set(const Selection& selection, const TriangleMesh& mesh,
+                               UnconstrainedPieces pieces, const std::vector<int>& file_index) {
   int count = 0;
   const Eigen::VectorXi components = vertex_components(mesh, &count);
-  return constrained_set(selection, components, count);
+  return constrained_set(selection, components, count, pieces, file_index);
 }
 
 ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi& label,
-                               int components) {
+                               int components, UnconstrainedPieces pieces,
+                               const std::vector<int>& file_index) {
   const int n = static_cast<int>(label.size());
+  const auto vertex = [&](int v) {
+    return "vertex " + std::to_string(file_index.empty() ? v : file_index[v]);
+  };
   ConstrainedSet set;
   set.num_groups = static_cast<int>(selection.handles.size());
   std::vector<int> owner(n, -2);
@@ -26,7 +31,7 @@ ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi
     }
     if (owner[v] != -2) {
       if (owner[v] == group) return;  // listed twice in the same group
-      throw InputError("selection: vertex " + std::to_string(v) + " belongs to two groups");
+      throw InputError("selection: " + vertex(v) + " belongs to two groups");
     }
     owner[v] = group;
     set.vertices.push_back(v);
@@ -38,11 +43,27 @@ ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi
   if (set.vertices.empty()) throw InputError("selection: no handle and no fixed vertex");
   std::vector<char> pinned(components, 0);
   for (const int v : set.vertices) pinned[label[v]] = 1;
+  std::vector<int> size(components, 0), first(components, -1);
+  for (int v = 0; v < n; ++v) {
+    if (size[label[v]]++ == 0) first[label[v]] = v;
+  }
+  set.first_held = set.vertices.size();
   for (int c = 0; c < components; ++c) {
-    if (!pinned[c]) {
-      throw InputError("selection: connected component " + std::to_string(c) + " of " +
-                       std::to_string(components) +
-                       " has no handle or fixed vertex, so its position is undefined");
+    if (pinned[c]) continue;
+    if (pieces == UnconstrainedPieces::Error) {
+      throw InputError("selection: connected component " + std::to_string(c + 1) + " of " +
+                       std::to_string(components) + " (" + std::to_string(size[c]) +
+                       " vertices, the first " + vertex(first[c]) +
+                       ") has no handle or fixed vertex, so its position is undefined");
+    }
+    ++set.held_pieces;
+  }
+  if (set.held_pieces > 0) {
+    for (int v = 0; v < n; ++v) {
+      if (!pinned[label[v]]) {
+        set.vertices.push_back(v);
+        set.group.push_back(-1);
+      }
     }
   }
   return set;

@@ -21,8 +21,12 @@ SpatialSolver::SpatialSolver(const TriangleMesh& mesh, const DeformOptions& opti
     throw InputError("spatial solver: some vertices have zero area (only degenerate faces)");
   }
   vertex_area_ = mass / area;
-  const Eigen::SparseMatrix<double> Dinv_K = mass.cwiseInverse().asDiagonal() * K;
-  A_ = options.ks * K + (options.kb * area) * Eigen::SparseMatrix<double>(K * Dinv_K);
+  if (options.energy == DeformEnergy::Arap) {
+    A_ = K;
+  } else {
+    const Eigen::SparseMatrix<double> Dinv_K = mass.cwiseInverse().asDiagonal() * K;
+    A_ = options.ks * K + (options.kb * area) * Eigen::SparseMatrix<double>(K * Dinv_K);
+  }
   A_.makeCompressed();
 }
 
@@ -72,25 +76,52 @@ void SpatialSolver::set_constraints(const std::vector<int>& vertices) {
   }
 }
 
-Eigen::MatrixX3d SpatialSolver::solve(const Eigen::MatrixX3d& targets) const {
-  const int n = static_cast<int>(A_.rows());
+SpatialSolver::Targets SpatialSolver::prepare(const Eigen::MatrixX3d& targets) const {
   if (targets.rows() != static_cast<Eigen::Index>(constrained_.size())) {
     throw InputError("deformation: targets for " + std::to_string(targets.rows()) +
                      " vertices, the selection has " + std::to_string(constrained_.size()));
   }
-  Eigen::MatrixX3d d = Eigen::MatrixX3d::Zero(n, 3);
+  Targets out{targets, 0.0};
   if (options_.constraints == ConstraintMode::Soft) {
-    Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(n, 3);
+    for (size_t i = 0; i < constrained_.size(); ++i) {
+      out.constant +=
+          options_.constraint_weight * vertex_area_[constrained_[i]] * targets.row(i).squaredNorm();
+    }
+  }
+  return out;
+}
+
+Eigen::MatrixX3d SpatialSolver::solve(const Targets& targets, const Eigen::MatrixX3d& g) const {
+  const int n = static_cast<int>(A_.rows());
+  const Eigen::MatrixX3d& t = targets.values;
+  if (options_.constraints == ConstraintMode::Soft) {
+    Eigen::MatrixX3d rhs = g.rows() == 0 ? Eigen::MatrixX3d(Eigen::MatrixX3d::Zero(n, 3)) : g;
     for (size_t i = 0; i < constrained_.size(); ++i) {
       const int v = constrained_[i];
-      rhs.row(v) = options_.constraint_weight * vertex_area_[v] * targets.row(i);
+      rhs.row(v) += options_.constraint_weight * vertex_area_[v] * t.row(i);
     }
     return factor_->llt.solve(rhs);
   }
-  const Eigen::MatrixX3d free = factor_->llt.solve(-(coupling_ * targets));
+  Eigen::MatrixX3d rhs = -(coupling_ * t);
+  if (g.rows() != 0) {
+    for (size_t i = 0; i < free_.size(); ++i) rhs.row(i) += g.row(free_[i]);
+  }
+  const Eigen::MatrixX3d free = factor_->llt.solve(rhs);
+  Eigen::MatrixX3d d(n, 3);
   for (size_t i = 0; i < free_.size(); ++i) d.row(free_[i]) = free.row(i);
-  for (size_t i = 0; i < constrained_.size(); ++i) d.row(constrained_[i]) = targets.row(i);
+  for (size_t i = 0; i < constrained_.size(); ++i) d.row(constrained_[i]) = t.row(i);
   return d;
+}
+
+double SpatialSolver::energy(const Targets& targets, const Eigen::MatrixX3d& d) const {
+  double e = (d.array() * (A_ * d).array()).sum();
+  if (options_.constraints == ConstraintMode::Soft) {
+    for (size_t i = 0; i < constrained_.size(); ++i) {
+      e += options_.constraint_weight * vertex_area_[constrained_[i]] *
+           (d.row(constrained_[i]) - targets.values.row(i)).squaredNorm();
+    }
+  }
+  return e;
 }
 
 }  // namespace specdeform

@@ -27,41 +27,54 @@ class Clock {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
+// The reduced Hessian D of the energy (reduced_solver.h); eigenvalues of -1e-14 count as 0.
+Eigen::VectorXd reduced_hessian(const ManifoldHarmonics& basis, double area,
+                                const DeformOptions& options) {
+  const Eigen::ArrayXd lambda = basis.eigenvalues.array().max(0.0);
+  if (options.energy == DeformEnergy::Arap) return lambda.matrix();
+  return (options.ks * lambda + options.kb * area * lambda.square()).matrix();
+}
+
 }  // namespace
 
 SpectralDeformer::SpectralDeformer(TriangleMesh mesh, ManifoldHarmonics basis,
                                    const DeformOptions& options)
+    : SpectralDeformer(std::move(mesh), std::make_shared<const ManifoldHarmonics>(std::move(basis)),
+                       options) {}
+
+SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
+                                   std::shared_ptr<const ManifoldHarmonics> basis,
+                                   const DeformOptions& options)
     : mesh_(std::move(mesh)), basis_(std::move(basis)), options_(options) {
+  options_.validate();
   const int n = mesh_.num_vertices();
-  const bool has_basis = basis_.basis.cols() > 0;
-  if (has_basis && basis_.basis.rows() != n) {
-    throw InputError("deformation: the basis has " + std::to_string(basis_.basis.rows()) +
+  const bool has_basis = basis_ && basis_->basis.cols() > 0;
+  if (has_basis && basis_->basis.rows() != n) {
+    throw InputError("deformation: the basis has " + std::to_string(basis_->basis.rows()) +
                      " rows, the mesh " + std::to_string(n) + " vertices");
   }
   if (!has_basis && options_.solver == DeformSolver::Spectral) {
     throw InputError("deformation: the spectral solver needs a basis");
   }
-  if (!(options_.ks >= 0 && options_.kb >= 0 && options_.ks + options_.kb > 0)) {
-    throw InputError("deformation: ks and kb must be >= 0 and not both 0");
-  }
-  if (!(options_.constraint_weight > 0) || !std::isfinite(options_.constraint_weight)) {
-    throw InputError("deformation: the constraint weight must be positive");
-  }
   Clock clock;
   components_ = vertex_components(mesh_, &num_components_);
   const Eigen::VectorXd area = lumped_mass(mesh_);
   if (has_basis) {
-    base_ = harmonics_inverse(
-        basis_.basis, harmonics_forward(basis_.basis, mass_matrix(mesh_, basis_.mass), mesh_.V));
+    const Eigen::MatrixXd& H = basis_->basis;
+    base_ = harmonics_inverse(H, harmonics_forward(H, mass_matrix(mesh_, basis_->mass), mesh_.V));
   } else {
     base_ = mesh_.V;
   }
-  if (options_.solver == DeformSolver::Spectral) {
-    reduced_ = std::make_unique<ReducedSolver>(basis_.basis, basis_.eigenvalues, area, area.sum(),
-                                               options_);
-    if (options_.float32_basis) basis32_ = basis_.basis.cast<float>();
+  const bool spectral = options_.solver == DeformSolver::Spectral;
+  if (spectral) {
+    reduced_ = std::make_unique<ReducedSolver>(
+        basis_, reduced_hessian(*basis_, area.sum(), options_), area / area.sum(), options_);
+    if (options_.float32_basis) basis32_ = basis_->basis.cast<float>();
   } else {
     spatial_ = std::make_unique<SpatialSolver>(mesh_, options_);
+  }
+  if (options_.energy == DeformEnergy::Arap) {
+    arap_ = std::make_unique<ArapSolver>(mesh_, base_, spectral ? basis_ : nullptr, options_.arap);
   }
   setup_.reduced_system = clock.lap();
   details_ = std::make_unique<DetailReconstruction>(mesh_, base_, options_.detail);
@@ -75,7 +88,7 @@ SpectralDeformer& SpectralDeformer::operator=(SpectralDeformer&&) noexcept = def
 
 void SpectralDeformer::set_selection(const Selection& selection) {
   Clock total, clock;
-  constrained_ = constrained_set(selection, components_, num_components_);
+  constrained_ = constrained_set(selection, components_, num_components_, options_.unconstrained);
   if (reduced_) {
     reduced_->set_constraints(constrained_.vertices);
   } else {
@@ -97,25 +110,42 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
   Eigen::MatrixX3d displacement_targets = base_targets;
   for (size_t i = 0; i < constrained_.vertices.size(); ++i)
     displacement_targets.row(i) -= base_.row(constrained_.vertices[i]);
+  // ARAP starts from the rest pose, or from the last frame when asked to.
+  const Eigen::Index size = reduced_ ? basis_->basis.cols() : mesh_.num_vertices();
+  const bool warm = options_.arap.warm_start && solution_.rows() == size;
+  const Eigen::MatrixX3d start = warm ? solution_ : Eigen::MatrixX3d::Zero(size, 3);
+  arap_report_ = ArapReport{};
+  arap_report_.converged = true;
   if (reduced_) {
-    const Eigen::MatrixX3d c = reduced_->solve(displacement_targets);
+    const ReducedSolver::Targets targets = reduced_->prepare(displacement_targets);
+    solution_ = arap_ ? arap_->solve(*reduced_, targets, start, &arap_report_)
+                      : reduced_->solve(targets, Eigen::MatrixX3d());
     frame_.reduced_solve = clock.lap();
     if (options_.float32_basis) {
-      detail::add_basis_product(base_, basis32_, c, deformed_base_);
+      detail::add_basis_product(base_, basis32_, solution_, deformed_base_);
     } else {
-      detail::add_basis_product(base_, basis_.basis, c, deformed_base_);
+      detail::add_basis_product(base_, basis_->basis, solution_, deformed_base_);
     }
     frame_.inverse_transform = clock.lap();
   } else {
-    const Eigen::MatrixX3d d = spatial_->solve(displacement_targets);
+    const SpatialSolver::Targets targets = spatial_->prepare(displacement_targets);
+    solution_ = arap_ ? arap_->solve(*spatial_, targets, start, &arap_report_)
+                      : spatial_->solve(targets, Eigen::MatrixX3d());
     frame_.reduced_solve = clock.lap();
-    deformed_base_ = base_ + d;
+    deformed_base_ = base_ + solution_;
     frame_.inverse_transform = clock.lap();
   }
+  // Held pieces stay exactly where they are (the solvers hold them only as well as soft
+  // constraints do).
+  const std::vector<int>& constrained = constrained_.vertices;
+  for (size_t i = constrained_.first_held; i < constrained.size(); ++i)
+    deformed_base_.row(constrained[i]) = base_.row(constrained[i]);
   detail_targets_ = options_.detail == DetailMethod::None
                         ? base_targets
                         : constraint_targets(constrained_, mesh_.V, transforms);
   Vertices result = details_->apply(deformed_base_, detail_targets_);
+  for (size_t i = constrained_.first_held; i < constrained.size(); ++i)
+    result.row(constrained[i]) = detail_targets_.row(i);
   frame_.detail = clock.lap();
   frame_.total = total.lap();
   return result;
@@ -134,6 +164,16 @@ ConstraintError SpectralDeformer::constraint_error(const Vertices& result) const
   e.max /= diagonal;
   e.rms = std::sqrt(sum / constrained_.vertices.size()) / diagonal;
   return e;
+}
+
+Vertices deform(const TriangleMesh& mesh, const ManifoldHarmonics& basis,
+                const Selection& selection, const std::vector<Eigen::Affine3d>& transforms,
+                const DeformOptions& options) {
+  // The deformer lives only in this call: it may use the caller's basis without owning it.
+  const std::shared_ptr<const ManifoldHarmonics> borrowed(std::shared_ptr<void>(), &basis);
+  SpectralDeformer deformer(mesh, borrowed, options);
+  deformer.set_selection(selection);
+  return deformer.solve(transforms);
 }
 
 }  // namespace specdeform

@@ -324,10 +324,12 @@ TEST(SpectralDeformer, ClearErrors) {
   Eigen::Affine3d nan = Eigen::Affine3d::Identity();
   nan.translation().x() = std::nan("");
   EXPECT_THROW(soft.solve({nan}), InputError);
-  // A component without constraints cannot be placed.
+  // A component without constraints is an error when the options ask for one.
   TriangleMesh two = test::concatenate(make_icosphere(1), make_icosphere(1));
   two.V.bottomRows(42).col(0).array() += 3.0;
-  SpectralDeformer spheres(two, harmonics(two, 10));
+  DeformOptions strict;
+  strict.unconstrained = UnconstrainedPieces::Error;
+  SpectralDeformer spheres(two, harmonics(two, 10), strict);
   EXPECT_THROW(spheres.set_selection({{{0}}, {}}), InputError);
   EXPECT_THROW(SpectralDeformer(s.mesh, ManifoldHarmonics{}), InputError);  // spectral, no basis
 }

@@ -1,18 +1,27 @@
 // Options of the deformation solvers (spectral and spatial) and of the detail reconstruction.
 //
-// The energy of a displacement field d (n x 3) of the base surface is the linearised
-// thin-shell energy of Rong, Cao & Guo 2008 (eqs. 10-13) in symmetric form,
-//     E(d) = ks d^T K d + kb d^T K M^-1 K d,
-// K the cotangent stiffness matrix, M the mass matrix, both measured on the mesh scaled to unit
-// area: stretching and bending then scale alike (as length^2), so ks, kb and the constraint
-// weight mean the same on any mesh size and resolution. Soft constraints add
-//     w sum_{i in C} a_i |d_i - t_i|^2,
-// a_i the vertex's lumped area on the same unit-area scale (so w does not depend on resolution).
+// Two energies of the displacement d (n x 3) of the smooth base s, both on the mesh scaled to
+// unit area (so the weights mean the same on any mesh size and resolution):
+//  - Linear: the linearised thin-shell energy of Rong, Cao & Guo 2008 (eqs. 10-13) in symmetric
+//    form,  E(d) = ks d^T K d + kb d^T K M^-1 K d,  K the cotangent stiffness matrix, M the mass
+//    matrix. One linear solve per frame, but it cannot rotate: a turned handle shrinks the
+//    surface between it and the fixed part (the "candy wrapper").
+//  - Arap: as-rigid-as-possible (Sorkine & Alexa 2007) on the smooth base's edges, with one
+//    rotation per cluster of vertices instead of one per vertex,
+//        E(s') = 1/2 sum_i sum_{j ~ i} w_ij |(s'_i - s'_j) - R_k(i) (s_i - s_j)|^2,
+//    w_ij the cotangent weights of K; minimised by local/global iterations (arap_solver.h).
+// Soft constraints add  w sum_{i in C} a_i |s'_i - t_i|^2,  a_i the vertex's lumped area on the
+// unit-area scale (so w does not depend on resolution).
 #pragma once
 
 #include <string_view>
 
 namespace specdeform {
+
+enum class DeformEnergy {
+  Linear,  // the paper's linearised thin shell: one solve per frame, no rotation
+  Arap,    // as-rigid-as-possible, one rotation per vertex cluster: local/global iterations
+};
 
 enum class ConstraintMode {
   Soft,  // least squares, area-weighted (the default)
@@ -31,23 +40,50 @@ enum class DetailMethod {
   Transfer,      // deformation transfer with a prefactored Poisson system (the default)
 };
 
+// A connected component of the mesh with no handle or fixed vertex.
+enum class UnconstrainedPieces {
+  Keep,   // stays where it is (its vertices are held in place); counted in the report
+  Error,  // is an InputError naming the piece
+};
+
+// The local/global iterations of DeformEnergy::Arap.
+struct ArapOptions {
+  int clusters = 200;        // rotation clusters (at least one per connected component)
+  int max_iterations = 100;  // a cap on the iterations per frame
+  double tolerance = 1e-4;   // stop when an iteration lowers the energy by less than this
+                             // fraction of the energy's scale (see arap_solver.h)
+  int anderson_window = 5;   // previous iterates Anderson acceleration mixes; 0: none
+  bool warm_start = false;   // start from the previous frame's solution instead of the rest
+                             // pose (interactive drags; not for timing a cold frame)
+};
+
 struct DeformOptions {
-  double ks = 0.0;  // stretching weight
-  double kb = 1.0;  // bending weight
+  DeformEnergy energy = DeformEnergy::Linear;
+  double ks = 0.0;  // Linear: stretching weight
+  double kb = 1.0;  // Linear: bending weight
+  ArapOptions arap;
   ConstraintMode constraints = ConstraintMode::Soft;
   double constraint_weight = 1e5;  // w of the soft constraints
   DeformSolver solver = DeformSolver::Spectral;
   DetailMethod detail = DetailMethod::Transfer;
+  UnconstrainedPieces unconstrained = UnconstrainedPieces::Keep;
   bool float32_basis = false;  // keep the basis in single precision (faster frames)
+
+  // Throws InputError, naming the field, for a value out of range.
+  void validate() const;
 };
 
 // The modes' names in scene files, on the command line and in the editor ("soft", "spatial",
 // "transfer", ...). The *_from_name functions throw InputError for an unknown name.
+std::string_view name(DeformEnergy energy);
 std::string_view name(ConstraintMode mode);
 std::string_view name(DeformSolver solver);
 std::string_view name(DetailMethod method);
+std::string_view name(UnconstrainedPieces pieces);
+DeformEnergy deform_energy_from_name(std::string_view name);
 ConstraintMode constraint_mode_from_name(std::string_view name);
 DeformSolver deform_solver_from_name(std::string_view name);
 DetailMethod detail_method_from_name(std::string_view name);
+UnconstrainedPieces unconstrained_pieces_from_name(std::string_view name);
 
 }  // namespace specdeform

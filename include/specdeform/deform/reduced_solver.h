@@ -1,58 +1,78 @@
 // The deformation of the smooth base in the spectral domain (Rong, Cao & Guo 2008, section 4.3,
 // done as in the technical notes rather than literally).
 //
-// With d = H c, H the n x m manifold harmonics (H^T M H = I, mesh units) and Lambda their
-// eigenvalues, the energy of deform_options.h is exactly
-//     E = c^T (ks Lambda + kb A Lambda^2) c            (A = surface area: unit-area scaling)
-// a diagonal Hessian, the same for x, y and z; no n x n product is ever formed.
-//  - Soft constraints: (D + w H_C^T W_C H_C) c = w H_C^T W_C t, factored (Cholesky, m x m) once
-//    per selection in O(n' m^2 + m^3) — or, when the selection changes by a few vertices, in
-//    O(changed m^2 + m^3) by updating the normal matrix — and solved per frame in O(n'' m + m^2),
-//    n'' the constrained vertices that move (the fixed ones add nothing).
-//  - Hard constraints: minimise c^T D c subject to H_C c = t (null-space method on a QR of
-//    H_C^T); needs H_C (n' x m) of full row rank, so n' <= m: otherwise InputError.
+// With d = H c, H the n x m manifold harmonics (H^T M H = I, mesh units), every energy of
+// deform_options.h has a diagonal reduced Hessian D (m), the same for x, y and z:
+//     linear:  D = ks Lambda + kb A Lambda^2     (A = surface area: unit-area scaling)
+//     ARAP:    D = Lambda                        (its global step; arap_solver.h)
+// This solver minimises, over the coefficients c (m x 3),
+//     E(c) = tr(c^T D c) - 2 tr(c^T g) + constraints
+// for a linear term g (m x 3; zero for the linear energy). No n x n product is ever formed.
+//  - Soft constraints: w sum_C a_i |h_i^T c - t_i|^2, so (D + w H_C^T W_C H_C) c = w H_C^T W_C t
+//    + g, factored (Cholesky, m x m) once per selection in O(n' m^2 + m^3) — or, when the
+//    selection changes by a few vertices, in O(changed m^2 + m^3) by updating the normal matrix
+//    — and solved per frame in O(n'' m + m^2), n'' the constrained vertices that move.
+//  - Hard constraints: H_C c = t exactly (null-space method on a QR of H_C^T); needs H_C
+//    (n' x m) of full row rank, so n' <= m: otherwise InputError.
 // Targets t are displacements (n' x 3) of the constrained vertices.
 #pragma once
 
+#include <memory>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <Eigen/QR>
 
 #include "specdeform/deform/deform_options.h"
+#include "specdeform/spectral/manifold_harmonics.h"
 
 namespace specdeform {
 
 class ReducedSolver {
  public:
-  // basis: n x m; eigenvalues: m; vertex_area: lumped mass (n); area: the surface area.
-  ReducedSolver(const Eigen::MatrixXd& basis, const Eigen::VectorXd& eigenvalues,
-                const Eigen::VectorXd& vertex_area, double area, const DeformOptions& options);
+  // hessian: D (m, >= 0); vertex_area: lumped mass (n) on the unit-area scale.
+  ReducedSolver(std::shared_ptr<const ManifoldHarmonics> basis, Eigen::VectorXd hessian,
+                Eigen::VectorXd vertex_area, const DeformOptions& options);
 
   // Factors the reduced system for these constrained vertices.
   void set_constraints(const std::vector<int>& vertices);
 
-  // Spectral coefficients c (m x 3) of the displacement for target displacements t (n' x 3).
-  Eigen::MatrixX3d solve(const Eigen::MatrixX3d& targets) const;
+  // What one frame's targets contribute, computed once per frame: soft, the right-hand side
+  // w H_C^T W_C t and the constant w sum a_i |t_i|^2; hard, the minimiser for g = 0.
+  struct Targets {
+    Eigen::MatrixX3d rhs;
+    double constant = 0.0;
+  };
+  Targets prepare(const Eigen::MatrixX3d& targets) const;
 
-  // The diagonal Hessian D = ks Lambda + kb A Lambda^2 (m).
+  // The minimiser c (m x 3) of E for the targets and a linear term g (m x 3, or 0 rows for none).
+  Eigen::MatrixX3d solve(const Targets& targets, const Eigen::MatrixX3d& g) const;
+  Eigen::MatrixX3d solve(const Eigen::MatrixX3d& targets) const {
+    return solve(prepare(targets), Eigen::MatrixX3d());
+  }
+
+  // E(c) without the linear term: tr(c^T D c) plus, soft, the constraint term (hard: c is taken
+  // to meet the constraints).
+  double energy(const Targets& targets, const Eigen::MatrixX3d& c) const;
+
   const Eigen::VectorXd& hessian() const { return hessian_; }
 
  private:
   // The soft constraint's weight of a vertex: constraint_weight times its (unit-scale) area.
   double weight(int vertex) const { return options_.constraint_weight * vertex_area_[vertex]; }
 
-  const Eigen::MatrixXd& basis_;
-  Eigen::VectorXd vertex_area_;  // on the unit-area scale
+  std::shared_ptr<const ManifoldHarmonics> basis_;
   Eigen::VectorXd hessian_;
+  Eigen::VectorXd vertex_area_;  // on the unit-area scale
   DeformOptions options_;
   Eigen::MatrixXd columns_;     // H_C^T, m x n'
   Eigen::VectorXd weights_;     // w W_C (n')
   std::vector<int> column_of_;  // vertex -> its column of columns_, or -1
   Eigen::MatrixXd normal_;      // soft: D + w H_C^T W_C H_C
   Eigen::LLT<Eigen::MatrixXd> soft_;
-  // Hard: c = Q1 R^-T t + Q2 z, z = -(Q2^T D Q2)^-1 Q2^T D Q1 R^-T t, i.e. c = P t.
-  Eigen::MatrixXd hard_;  // P, m x n'
+  // Hard: c = Q1 R^-T t + Q2 z, z = (Q2^T D Q2)^-1 Q2^T (g - D Q1 R^-T t), i.e. c = P t + Z g.
+  Eigen::MatrixXd hard_;       // P, m x n'
+  Eigen::MatrixXd hard_free_;  // Z = Q2 (Q2^T D Q2)^-1 Q2^T, m x m
 };
 
 }  // namespace specdeform

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "specdeform/deform/deform_options.h"
 #include "specdeform/mesh/triangle_mesh.h"
 
 namespace specdeform {
@@ -20,19 +21,28 @@ struct Selection {
 };
 
 // The constrained vertices of a selection in one list, with the group of each (-1 = fixed).
+// The vertices of held pieces (connected components without a handle or fixed vertex, under
+// UnconstrainedPieces::Keep) end the list, as fixed vertices, from index `first_held` on.
 struct ConstrainedSet {
   std::vector<int> vertices;
   std::vector<int> group;
   int num_groups = 0;
+  int held_pieces = 0;
+  size_t first_held = 0;
 };
 
-// Throws InputError for an empty selection, an index out of [0, n), a vertex in two groups, or a
-// connected component of the mesh with no constrained vertex (its position would be undefined).
-ConstrainedSet constrained_set(const Selection& selection, const TriangleMesh& mesh);
+// Throws InputError for an empty selection, an index out of [0, n), a vertex in two groups, or,
+// under UnconstrainedPieces::Error, a connected component with no constrained vertex (the
+// message names its size and its first vertex). Messages name vertex v as file_index[v] when
+// file_index is given (the file's numbering, MeshReadInfo::vertex_to_file).
+ConstrainedSet constrained_set(const Selection& selection, const TriangleMesh& mesh,
+                               UnconstrainedPieces pieces = UnconstrainedPieces::Keep,
+                               const std::vector<int>& file_index = {});
 
 // The same with the mesh's vertex_components() computed beforehand (labels 0 .. count-1).
 ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi& components,
-                               int count);
+                               int count, UnconstrainedPieces pieces,
+                               const std::vector<int>& file_index = {});
 
 // Target position of every constrained vertex (|C| x 3): the group's transform applied to
 // `positions` (fixed vertices keep theirs). Throws InputError for a wrong number of transforms

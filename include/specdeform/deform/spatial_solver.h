@@ -2,9 +2,13 @@
 // (Rong, Cao & Guo 2008, eq. 14, with a sparse Cholesky factorisation instead of the paper's
 // iterative BiCG), the baseline of the benchmarks and the ground truth of the tests.
 //
-//   A = ks K + kb A_s K D^-1 K      (n x n, D the lumped mass, A_s the surface area)
-//   hard: Dirichlet conditions d_C = t, A_FF d_F = -A_FC t
-//   soft: (A + w W) d = w W t, W = a_i on the constrained vertices
+// Over the displacement d (n x 3) it minimises
+//     E(d) = tr(d^T A d) - 2 tr(d^T g) + constraints,
+//   A = ks K + kb A_s K D^-1 K   (linear energy; D the lumped mass, A_s the surface area)
+//   A = K                        (ARAP's global step; arap_solver.h)
+// for a linear term g (n x 3; zero for the linear energy):
+//   hard: Dirichlet conditions d_C = t, A_FF d_F = g_F - A_FC t
+//   soft: (A + w W) d = w W t + g, W = a_i on the constrained vertices
 // factored with CHOLMOD once per selection; each frame is one back-substitution (3 columns).
 // The bi-Laplacian always uses the lumped mass (the consistent one would make it dense).
 #pragma once
@@ -29,8 +33,21 @@ class SpatialSolver {
   // Factors the system for these constrained vertices. Throws SolverError if it is singular.
   void set_constraints(const std::vector<int>& vertices);
 
-  // Displacement of every vertex (n x 3) for target displacements t (n' x 3).
-  Eigen::MatrixX3d solve(const Eigen::MatrixX3d& targets) const;
+  // One frame's targets (displacements, n' x 3) as the solve and the energy use them.
+  struct Targets {
+    Eigen::MatrixX3d values;
+    double constant = 0.0;  // soft: w sum a_i |t_i|^2
+  };
+  Targets prepare(const Eigen::MatrixX3d& targets) const;
+
+  // The minimiser d (n x 3) of E for the targets and a linear term g (n x 3, or 0 rows).
+  Eigen::MatrixX3d solve(const Targets& targets, const Eigen::MatrixX3d& g) const;
+  Eigen::MatrixX3d solve(const Eigen::MatrixX3d& targets) const {
+    return solve(prepare(targets), Eigen::MatrixX3d());
+  }
+
+  // E(d) without the linear term: tr(d^T A d) plus, soft, the constraint term.
+  double energy(const Targets& targets, const Eigen::MatrixX3d& d) const;
 
   // The energy's matrix A (n x n), on the unit-area scale.
   const Eigen::SparseMatrix<double>& energy_matrix() const { return A_; }

@@ -1,17 +1,20 @@
 // Spectral mesh deformation (Rong, Cao & Guo, "Spectral mesh deformation", The Visual Computer
 // 2008): low-pass the mesh to its first m manifold harmonics, deform that smooth base by
-// minimising the energy of deform_options.h in the m-dimensional spectral space under the
-// handle constraints, and add the details back.
+// minimising an energy of deform_options.h (the paper's linear shell, or ARAP) in the
+// m-dimensional spectral space under the handle constraints, and add the details back.
 //
 // Built once per mesh and basis; set_selection() once per selection (handles, fixed set);
 // solve() once per frame with one transform per handle group. With DeformSolver::Spatial the
 // base's displacement is computed over all n vertices instead (the reference of eq. 14); the
-// basis then only defines the smooth base, and may be empty, in which case the base is the mesh.
+// basis then only defines the smooth base, and may be null or empty, in which case the base is
+// the mesh. The basis is shared, never copied: the caller may keep using it.
 //
 // Targets: the smooth base's handle vertices follow their group's transform (T s_i) and its
 // fixed vertices stay; the detailed result's handle vertices should reach T x_i and its fixed
 // vertices x_i. Transfer anchors them there exactly; the other methods meet them only as far as
-// the base does (constraint_error() measures it).
+// the base does (constraint_error() measures it). A connected component without a handle or
+// fixed vertex stays where it is (UnconstrainedPieces::Keep: its vertices are held like fixed
+// ones and returned unchanged) or is an InputError.
 //
 //   SpectralDeformer deformer(mesh, compute_manifold_harmonics(mesh, {.num_modes = 100}));
 //   deformer.set_selection({.handles = {hand}, .fixed = feet});
@@ -23,6 +26,7 @@
 
 #include <Eigen/Geometry>
 
+#include "specdeform/deform/arap_solver.h"
 #include "specdeform/deform/deform_options.h"
 #include "specdeform/deform/detail_reconstruction.h"
 #include "specdeform/deform/selection.h"
@@ -36,15 +40,17 @@ class SpatialSolver;
 
 // Seconds spent in each stage.
 struct SetupTimings {
-  double reduced_system = 0.0;        // spectral: Hessian and base (once per mesh); spatial: its
-                                      // factorisation for the last selection
+  double reduced_system = 0.0;        // spectral: Hessian, base and ARAP's cluster operator
+                                      // (once per mesh); spatial: its factorisation for the
+                                      // last selection
   double detail_factorization = 0.0;  // Transfer: Poisson analysis (once per mesh), then the
                                       // factorisation or its update for the last selection
   double selection = 0.0;             // the whole of the last set_selection()
 };
 
 struct FrameTimings {
-  double reduced_solve = 0.0;      // spectral coefficients (spatial: the back-substitution)
+  double reduced_solve = 0.0;      // spectral coefficients, all ARAP iterations included
+                                   // (spatial: the back-substitutions)
   double inverse_transform = 0.0;  // d = H c and s' = s + d
   double detail = 0.0;             // adding the details back
   double total = 0.0;
@@ -58,6 +64,10 @@ struct ConstraintError {
 
 class SpectralDeformer {
  public:
+  // Throws InputError for options out of range (DeformOptions::validate) or a basis that does
+  // not fit the mesh.
+  SpectralDeformer(TriangleMesh mesh, std::shared_ptr<const ManifoldHarmonics> basis,
+                   const DeformOptions& options = {});
   SpectralDeformer(TriangleMesh mesh, ManifoldHarmonics basis, const DeformOptions& options = {});
   ~SpectralDeformer();
   SpectralDeformer(SpectralDeformer&&) noexcept;
@@ -73,27 +83,43 @@ class SpectralDeformer {
   ConstraintError constraint_error(const Vertices& result) const;
 
   const TriangleMesh& mesh() const { return mesh_; }
+  const std::shared_ptr<const ManifoldHarmonics>& basis() const { return basis_; }
   const Vertices& base() const { return base_; }                    // s
   const Vertices& deformed_base() const { return deformed_base_; }  // s' of the last solve
   const DeformOptions& options() const { return options_; }
   const SetupTimings& setup_timings() const { return setup_; }
   const FrameTimings& frame_timings() const { return frame_; }
+  // ARAP: the iterations of the last solve (the linear energy: none, converged).
+  const ArapReport& arap_report() const { return arap_report_; }
+  // ARAP: the number of rotation clusters (0 for the linear energy).
+  int rotation_clusters() const { return arap_ ? arap_->clusters() : 0; }
+  // Connected components held in place by the last selection (they had no constrained vertex).
+  int held_pieces() const { return constrained_.held_pieces; }
 
  private:
   TriangleMesh mesh_;
-  ManifoldHarmonics basis_;
+  std::shared_ptr<const ManifoldHarmonics> basis_;
   DeformOptions options_;
   Eigen::MatrixXf basis32_;  // float32_basis: the basis in single precision
   Vertices base_, deformed_base_;
   std::unique_ptr<ReducedSolver> reduced_;
   std::unique_ptr<SpatialSolver> spatial_;
+  std::unique_ptr<ArapSolver> arap_;
   std::unique_ptr<DetailReconstruction> details_;
   Eigen::VectorXi components_;  // connected component of each vertex
   int num_components_ = 0;
   ConstrainedSet constrained_;
+  Eigen::MatrixX3d solution_;        // c (spectral) or d (spatial) of the last solve
   Eigen::MatrixX3d detail_targets_;  // targets of the last solve, for constraint_error
+  ArapReport arap_report_;
   SetupTimings setup_;
   FrameTimings frame_;
 };
+
+// One deformation, start to finish: the detailed result of `selection` moved by `transforms`
+// (SpectralDeformer's set_selection and solve once). The basis is used, not copied.
+Vertices deform(const TriangleMesh& mesh, const ManifoldHarmonics& basis,
+                const Selection& selection, const std::vector<Eigen::Affine3d>& transforms,
+                const DeformOptions& options = {});
 
 }  // namespace specdeform

@@ -1,0 +1,72 @@
+// As-rigid-as-possible deformation of the smooth base (Sorkine & Alexa, "As-rigid-as-possible
+// surface modeling", 2007) with one rotation per vertex cluster, in the spectral subspace of
+// the manifold harmonics or over all vertices, accelerated by Anderson mixing with an energy
+// safeguard (Peng, Deng, Zhang & Liu, "Anderson acceleration for geometry optimization and
+// physics simulation", 2018).
+//
+// The energy of the deformed base s' = s + d (n x 3), with K's cotangent weights w_ij (K the
+// detailed mesh's stiffness matrix, so that the quadratic part is d's K-energy) and the
+// clusters of mesh/vertex_clusters.h (computed on s), is
+//     E(d, R) = 1/2 sum_i sum_{j ~ i} w_ij |(s'_i - s'_j) - R_k(i) (s_i - s_j)|^2 + constraints.
+// With the cluster operator Q (3k x m: Q_k = sum_{i in k, j ~ i} w_ij (s_i - s_j)(h_i - h_j)^T,
+// H the basis; over all vertices the sparse 3k x n operator with unit vectors for h) and d = H c:
+//  - local step: the covariance of cluster k is S_k = S_k(s) + Q_k c (3 x 3), and R_k maximises
+//    tr(R_k S_k) (SVD, reflections excluded): O(k m) per iteration;
+//  - global step: the minimiser of tr(c^T Lambda c) - 2 tr(c^T g) + constraints with
+//    g = 1/2 Q^T (R - I) (the blocks R_k^T - I stacked), one solve of the m x m system that
+//    ReducedSolver factors once per selection (D = Lambda): O(m^2) per iteration.
+// Each iteration is O(k m + m^2), independent of n. The energy tracked is E up to a term of
+// the order of the basis's eigen-residual (Lambda stands for H^T K H), minimised exactly by
+// each step: it never increases (Anderson steps that would raise it are rejected). Stops when
+// an iteration lowers the energy by less than `tolerance` times the energy, when the energy
+// falls below 1e-14 of its starting value, or at `max_iterations`. Energies are in the units
+// of the mesh's lengths squared, on the unit-area scale of deform_options.h.
+#pragma once
+
+#include <memory>
+
+#include <Eigen/Core>
+#include <Eigen/Sparse>
+
+#include "specdeform/deform/deform_options.h"
+#include "specdeform/deform/reduced_solver.h"
+#include "specdeform/deform/spatial_solver.h"
+#include "specdeform/mesh/triangle_mesh.h"
+#include "specdeform/spectral/manifold_harmonics.h"
+
+namespace specdeform {
+
+struct ArapReport {
+  int iterations = 0;            // local/global steps taken
+  int accelerated = 0;           // of which Anderson steps kept
+  double energy = 0.0;           // at the result
+  double relative_change = 0.0;  // the last step's decrease of the energy over the energy
+  bool converged = false;        // stopped by the tolerance, not by the cap
+};
+
+class ArapSolver {
+ public:
+  // mesh: the detailed mesh (its cotangent weights); base: its smooth base s (n x 3); basis:
+  // the manifold harmonics (the spectral subspace) or null (all vertices).
+  ArapSolver(const TriangleMesh& mesh, const Vertices& base,
+             std::shared_ptr<const ManifoldHarmonics> basis, const ArapOptions& options);
+
+  // Spectral: the coefficients c (m x 3) of the displacement H c, from `start` (m x 3).
+  Eigen::MatrixX3d solve(const ReducedSolver& solver, const ReducedSolver::Targets& targets,
+                         const Eigen::MatrixX3d& start, ArapReport* report = nullptr) const;
+  // All vertices: the displacement d (n x 3), from `start` (n x 3).
+  Eigen::MatrixX3d solve(const SpatialSolver& solver, const SpatialSolver::Targets& targets,
+                         const Eigen::MatrixX3d& start, ArapReport* report = nullptr) const;
+
+  int clusters() const { return static_cast<int>(rest_.rows() / 3); }
+  const Eigen::VectorXi& cluster_of_vertex() const { return label_; }
+
+ private:
+  ArapOptions options_;
+  Eigen::VectorXi label_;
+  Eigen::SparseMatrix<double> operator_;  // 3k x n (all vertices)
+  Eigen::MatrixXd reduced_;               // Q = operator_ H, 3k x m (spectral)
+  Eigen::MatrixX3d rest_;                 // S(s), 3k x 3
+};
+
+}  // namespace specdeform

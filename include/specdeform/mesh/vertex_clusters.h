@@ -1,0 +1,24 @@
+// Vertex clusters of about equal geodesic size: the rotation clusters of the ARAP energy
+// (deform_options.h) and any other per-region fit.
+//
+// Seeds by farthest-point sampling of the graph distance along the mesh's edges (Dijkstra,
+// edge lengths of the given positions), each new seed the vertex farthest from all earlier
+// ones; every vertex joins the cluster of its nearest seed (a graph Voronoi partition), so a
+// cluster is connected and never spans two connected components. Every component gets at least
+// one cluster: a mesh of c components with c > count has c clusters. Deterministic.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "specdeform/mesh/triangle_mesh.h"
+
+namespace specdeform {
+
+struct VertexClusters {
+  Eigen::VectorXi label;  // n, cluster of each vertex, 0 .. count-1
+  int count = 0;          // min(n, max(requested, connected components))
+};
+
+VertexClusters vertex_clusters(const TriangleMesh& mesh, int count);
+
+}  // namespace specdeform
