@@ -70,6 +70,14 @@ void DeformArgs::add_to(CLI::App& cmd) {
          "--iterations", options.arap.max_iterations,
          "ARAP: at most this many iterations per frame" + fallback(defaults.arap.max_iterations))
       ->check(CLI::Range(1, 1000000));
+  cmd.add_option("--arap-tolerance", options.arap.tolerance,
+                 "ARAP: stop when an iteration lowers the energy by less than this fraction" +
+                     fallback(defaults.arap.tolerance))
+      ->check(kNonNegative);
+  cmd.add_option(
+         "--anderson", options.arap.anderson_window,
+         "ARAP: Anderson acceleration window, 0: none" + fallback(defaults.arap.anderson_window))
+      ->check(CLI::Range(0, 20));
   cmd.add_option("--clusters", options.arap.clusters,
                  "ARAP: rotation clusters" + fallback(defaults.arap.clusters))
       ->check(CLI::Range(1, 100000000));
@@ -96,6 +104,8 @@ DeformOptions DeformArgs::merged(const CLI::App& cmd, const DeformOptions& scene
   const auto flag = [&](const char* name) { return cmd.count(name) > 0; };
   if (flag("--energy")) o.energy = options.energy;
   if (flag("--iterations")) o.arap.max_iterations = options.arap.max_iterations;
+  if (flag("--arap-tolerance")) o.arap.tolerance = options.arap.tolerance;
+  if (flag("--anderson")) o.arap.anderson_window = options.arap.anderson_window;
   if (flag("--clusters")) o.arap.clusters = options.arap.clusters;
   if (flag("--ks")) o.ks = options.ks;
   if (flag("--kb")) o.kb = options.kb;

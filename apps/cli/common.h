@@ -21,8 +21,9 @@ extern const CLI::Validator kPositive;
 // Accepts a number >= 0.
 extern const CLI::Validator kNonNegative;
 
-// The deformation settings' flags: --energy, --iterations, --clusters, --ks, --kb, --weight,
-// --detail, --solver, --constraints. merged(): a scene's settings where no flag was given.
+// The deformation settings' flags: --energy, --iterations, --arap-tolerance, --anderson,
+// --clusters, --ks, --kb, --weight, --detail, --solver, --constraints. merged(): a scene's settings
+// where no flag was given.
 struct DeformArgs {
   DeformOptions options;
   void add_to(CLI::App& cmd);

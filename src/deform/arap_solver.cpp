@@ -161,10 +161,19 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
   label_ = clusters.label;
   const Sparse A = cluster_operator(cotan_stiffness(mesh), base, label_, clusters.count);
   rest_ = A * base;
+  // The mean over each cluster's vertices (k x n), applied to the basis when there is one.
+  Eigen::VectorXd size = Eigen::VectorXd::Zero(clusters.count);
+  for (int i = 0; i < label_.size(); ++i) size[label_[i]] += 1.0;
+  std::vector<Eigen::Triplet<double>> mean;
+  for (int i = 0; i < label_.size(); ++i) mean.emplace_back(label_[i], i, 1.0 / size[label_[i]]);
+  Sparse cluster_mean(clusters.count, mesh.num_vertices());
+  cluster_mean.setFromTriplets(mean.begin(), mean.end());
   if (basis) {
     reduced_ = A * basis->basis;
+    reduced_mean_ = cluster_mean * basis->basis;
   } else {
     operator_ = A;
+    mean_ = cluster_mean;
   }
 }
 
@@ -177,44 +186,114 @@ double energy_scale(const Eigen::MatrixX3d& rest) {
   return std::abs(sum);
 }
 
+// The rotation vector (axis times angle) of the rotation nearest to `linear` (its polar part).
+Eigen::Vector3d rotation_vector(const Eigen::Matrix3d& linear) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(linear, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d U = svd.matrixU();
+  if ((U * svd.matrixV().transpose()).determinant() < 0) U.col(2) = -U.col(2);
+  const Eigen::AngleAxisd rotation(Eigen::Matrix3d(U * svd.matrixV().transpose()));
+  return rotation.angle() * rotation.axis();
+}
+
+// The cold start: each group's rotation spread over the clusters by harmonic weights, then the
+// global step with those rotations.
+template <typename Space>
+Eigen::MatrixX3d propagated_start(const Space& space, const ConstrainedSet& set,
+                                  const std::vector<Eigen::Affine3d>& transforms, int clusters) {
+  std::vector<Eigen::Vector3d> turn(set.num_groups);
+  for (int g = 0; g < set.num_groups; ++g) turn[g] = rotation_vector(transforms[g].linear());
+  Eigen::MatrixX3d blended = Eigen::MatrixX3d::Zero(clusters, 3);
+  for (int first = 0; first < set.num_groups; first += 3) {  // three groups per solve
+    bool turned = false;
+    Eigen::MatrixX3d indicator = Eigen::MatrixX3d::Zero(set.vertices.size(), 3);
+    for (size_t i = 0; i < set.vertices.size(); ++i) {
+      const int column = set.group[i] - first;
+      if (column < 0 || column >= 3 || turn[set.group[i]].isZero(0.0)) continue;
+      indicator(i, column) = 1.0;
+      turned = true;
+    }
+    if (!turned) continue;
+    const Eigen::MatrixX3d weights = space.cluster_means(space.harmonic(indicator));
+    for (int k = 0; k < clusters; ++k)
+      for (int j = 0; j < 3 && first + j < set.num_groups; ++j)
+        blended.row(k) += std::clamp(weights(k, j), 0.0, 1.0) * turn[first + j].transpose();
+  }
+  Eigen::MatrixX3d rotations(3 * clusters, 3);
+  for (int k = 0; k < clusters; ++k) {
+    const Eigen::Vector3d w = blended.row(k).transpose();
+    const double angle = w.norm();
+    const Eigen::Matrix3d R = angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix()
+                                          : Eigen::Matrix3d::Identity();
+    rotations.middleRows<3>(3 * k) = R.transpose() - Eigen::Matrix3d::Identity();
+  }
+  return space.global(rotations);
+}
+
 }  // namespace
+
+// The spaces the local/global iterations run in: covariance(x), global(rotations), energy(x),
+// and for the cold start harmonic(indicator) (the global step's system for constrained values)
+// and cluster_means(x).
+struct ArapSolver::ReducedSpace {
+  const ArapSolver& self;
+  const ReducedSolver& solver;
+  const ReducedSolver::Targets& targets;
+  Eigen::MatrixX3d covariance(const Eigen::MatrixX3d& c) const {
+    return self.rest_ + self.reduced_.lazyProduct(c);
+  }
+  Eigen::MatrixX3d global(const Eigen::MatrixX3d& rotations) const {
+    return solver.solve(targets, 0.5 * self.reduced_.transpose().lazyProduct(rotations));
+  }
+  double energy(const Eigen::MatrixX3d& c) const { return solver.energy(targets, c); }
+  Eigen::MatrixX3d harmonic(const Eigen::MatrixX3d& values) const { return solver.solve(values); }
+  Eigen::MatrixX3d cluster_means(const Eigen::MatrixX3d& c) const {
+    return self.reduced_mean_.lazyProduct(c);
+  }
+};
+
+struct ArapSolver::SpatialSpace {
+  const ArapSolver& self;
+  const SpatialSolver& solver;
+  const SpatialSolver::Targets& targets;
+  Eigen::MatrixX3d covariance(const Eigen::MatrixX3d& d) const {
+    return self.rest_ + self.operator_ * d;
+  }
+  Eigen::MatrixX3d global(const Eigen::MatrixX3d& rotations) const {
+    return solver.solve(targets, 0.5 * (self.operator_.transpose() * rotations));
+  }
+  double energy(const Eigen::MatrixX3d& d) const { return solver.energy(targets, d); }
+  Eigen::MatrixX3d harmonic(const Eigen::MatrixX3d& values) const { return solver.solve(values); }
+  Eigen::MatrixX3d cluster_means(const Eigen::MatrixX3d& d) const { return self.mean_ * d; }
+};
+
+Eigen::MatrixX3d ArapSolver::start(const ReducedSolver& solver,
+                                   const ReducedSolver::Targets& targets, const ConstrainedSet& set,
+                                   const std::vector<Eigen::Affine3d>& transforms) const {
+  if (reduced_.cols() == 0) throw InputError("ARAP: built without a basis");
+  return propagated_start(ReducedSpace{*this, solver, targets}, set, transforms, clusters());
+}
+
+Eigen::MatrixX3d ArapSolver::start(const SpatialSolver& solver,
+                                   const SpatialSolver::Targets& targets, const ConstrainedSet& set,
+                                   const std::vector<Eigen::Affine3d>& transforms) const {
+  if (operator_.cols() == 0) throw InputError("ARAP: built with a basis");
+  return propagated_start(SpatialSpace{*this, solver, targets}, set, transforms, clusters());
+}
 
 Eigen::MatrixX3d ArapSolver::solve(const ReducedSolver& solver,
                                    const ReducedSolver::Targets& targets,
                                    const Eigen::MatrixX3d& start, ArapReport* report) const {
   if (reduced_.cols() == 0) throw InputError("ARAP: built without a basis");
-  struct Space {
-    const ArapSolver& self;
-    const ReducedSolver& solver;
-    const ReducedSolver::Targets& targets;
-    Eigen::MatrixX3d covariance(const Eigen::MatrixX3d& c) const {
-      return self.rest_ + self.reduced_.lazyProduct(c);
-    }
-    Eigen::MatrixX3d global(const Eigen::MatrixX3d& rotations) const {
-      return solver.solve(targets, 0.5 * self.reduced_.transpose().lazyProduct(rotations));
-    }
-    double energy(const Eigen::MatrixX3d& c) const { return solver.energy(targets, c); }
-  };
-  return iterate(Space{*this, solver, targets}, start, energy_scale(rest_), options_, report);
+  return iterate(ReducedSpace{*this, solver, targets}, start, energy_scale(rest_), options_,
+                 report);
 }
 
 Eigen::MatrixX3d ArapSolver::solve(const SpatialSolver& solver,
                                    const SpatialSolver::Targets& targets,
                                    const Eigen::MatrixX3d& start, ArapReport* report) const {
   if (operator_.cols() == 0) throw InputError("ARAP: built with a basis");
-  struct Space {
-    const ArapSolver& self;
-    const SpatialSolver& solver;
-    const SpatialSolver::Targets& targets;
-    Eigen::MatrixX3d covariance(const Eigen::MatrixX3d& d) const {
-      return self.rest_ + self.operator_ * d;
-    }
-    Eigen::MatrixX3d global(const Eigen::MatrixX3d& rotations) const {
-      return solver.solve(targets, 0.5 * (self.operator_.transpose() * rotations));
-    }
-    double energy(const Eigen::MatrixX3d& d) const { return solver.energy(targets, d); }
-  };
-  return iterate(Space{*this, solver, targets}, start, energy_scale(rest_), options_, report);
+  return iterate(SpatialSpace{*this, solver, targets}, start, energy_scale(rest_), options_,
+                 report);
 }
 
 }  // namespace specdeform

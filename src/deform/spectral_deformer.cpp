@@ -110,16 +110,21 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
   Eigen::MatrixX3d displacement_targets = base_targets;
   for (size_t i = 0; i < constrained_.vertices.size(); ++i)
     displacement_targets.row(i) -= base_.row(constrained_.vertices[i]);
-  // ARAP starts from the rest pose, or from the last frame when asked to.
+  // ARAP starts from the handles' rotations spread over the surface, or from the last frame
+  // when asked to.
   const Eigen::Index size = reduced_ ? basis_->basis.cols() : mesh_.num_vertices();
   const bool warm = options_.arap.warm_start && solution_.rows() == size;
-  const Eigen::MatrixX3d start = warm ? solution_ : Eigen::MatrixX3d::Zero(size, 3);
   arap_report_ = ArapReport{};
   arap_report_.converged = true;
   if (reduced_) {
     const ReducedSolver::Targets targets = reduced_->prepare(displacement_targets);
-    solution_ = arap_ ? arap_->solve(*reduced_, targets, start, &arap_report_)
-                      : reduced_->solve(targets, Eigen::MatrixX3d());
+    if (arap_) {
+      const Eigen::MatrixX3d start =
+          warm ? solution_ : arap_->start(*reduced_, targets, constrained_, transforms);
+      solution_ = arap_->solve(*reduced_, targets, start, &arap_report_);
+    } else {
+      solution_ = reduced_->solve(targets, Eigen::MatrixX3d());
+    }
     frame_.reduced_solve = clock.lap();
     if (options_.float32_basis) {
       detail::add_basis_product(base_, basis32_, solution_, deformed_base_);
@@ -129,8 +134,13 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
     frame_.inverse_transform = clock.lap();
   } else {
     const SpatialSolver::Targets targets = spatial_->prepare(displacement_targets);
-    solution_ = arap_ ? arap_->solve(*spatial_, targets, start, &arap_report_)
-                      : spatial_->solve(targets, Eigen::MatrixX3d());
+    if (arap_) {
+      const Eigen::MatrixX3d start =
+          warm ? solution_ : arap_->start(*spatial_, targets, constrained_, transforms);
+      solution_ = arap_->solve(*spatial_, targets, start, &arap_report_);
+    } else {
+      solution_ = spatial_->solve(targets, Eigen::MatrixX3d());
+    }
     frame_.reduced_solve = clock.lap();
     deformed_base_ = base_ + solution_;
     frame_.inverse_transform = clock.lap();

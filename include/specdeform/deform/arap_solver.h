@@ -24,12 +24,14 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Sparse>
 
 #include "specdeform/deform/deform_options.h"
 #include "specdeform/deform/reduced_solver.h"
+#include "specdeform/deform/selection.h"
 #include "specdeform/deform/spatial_solver.h"
 #include "specdeform/mesh/triangle_mesh.h"
 #include "specdeform/spectral/manifold_harmonics.h"
@@ -51,6 +53,19 @@ class ArapSolver {
   ArapSolver(const TriangleMesh& mesh, const Vertices& base,
              std::shared_ptr<const ManifoldHarmonics> basis, const ArapOptions& options);
 
+  // The cold start of a frame: the rotation of each handle group (the polar part of its
+  // transform) spread over the surface, R_k = exp(sum_g phi_g,k log R_g) with phi_g the harmonic
+  // weight of group g (the global step's system solved for 1 on the group and 0 on the other
+  // constrained vertices, averaged over cluster k), then the global step with these rotations.
+  // A twisted or bent bar starts twisted or bent; from the rest pose the iterations would stall
+  // in the linear energy's collapsed shape. Spectral: m x 3; all vertices: n x 3.
+  Eigen::MatrixX3d start(const ReducedSolver& solver, const ReducedSolver::Targets& targets,
+                         const ConstrainedSet& set,
+                         const std::vector<Eigen::Affine3d>& transforms) const;
+  Eigen::MatrixX3d start(const SpatialSolver& solver, const SpatialSolver::Targets& targets,
+                         const ConstrainedSet& set,
+                         const std::vector<Eigen::Affine3d>& transforms) const;
+
   // Spectral: the coefficients c (m x 3) of the displacement H c, from `start` (m x 3).
   Eigen::MatrixX3d solve(const ReducedSolver& solver, const ReducedSolver::Targets& targets,
                          const Eigen::MatrixX3d& start, ArapReport* report = nullptr) const;
@@ -62,11 +77,15 @@ class ArapSolver {
   const Eigen::VectorXi& cluster_of_vertex() const { return label_; }
 
  private:
+  struct ReducedSpace;
+  struct SpatialSpace;
   ArapOptions options_;
   Eigen::VectorXi label_;
-  Eigen::SparseMatrix<double> operator_;  // 3k x n (all vertices)
-  Eigen::MatrixXd reduced_;               // Q = operator_ H, 3k x m (spectral)
-  Eigen::MatrixX3d rest_;                 // S(s), 3k x 3
+  // Over all vertices: the cluster operator (3k x n) and the mean over each cluster (k x n).
+  Eigen::SparseMatrix<double> operator_, mean_;
+  // Spectral: the same applied to the basis, Q = operator_ H (3k x m) and mean_ H (k x m).
+  Eigen::MatrixXd reduced_, reduced_mean_;
+  Eigen::MatrixX3d rest_;  // S(s), 3k x 3
 };
 
 }  // namespace specdeform
