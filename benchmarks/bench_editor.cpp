@@ -91,9 +91,12 @@ net::awaitable<void> run_client(uint16_t port, sd::Selection selection, Drag dra
   }));
   co_await ws.async_handshake(host, "/ws", net::use_awaitable);
   ws.binary(true);
-  co_await ws.async_write(
-      net::buffer(sd::server::encode_selection(selection, sd::server::Tag::Selection)),
-      net::use_awaitable);
+  sd::server::GroupSelection groups;
+  groups.selection = selection;
+  groups.transforms.assign(selection.handles.size(), Eigen::Affine3d::Identity());
+  groups.pinned.assign(selection.handles.size(), false);
+  const std::string message = sd::server::encode_selection(groups, sd::server::Tag::Selection);
+  co_await ws.async_write(net::buffer(message), net::use_awaitable);
 
   // A mouse: frames at a fixed rate, results read as they come.
   std::map<uint32_t, Clock::time_point> sent;

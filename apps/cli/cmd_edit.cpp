@@ -59,8 +59,9 @@ void add_edit_command(CLI::App& app) {
                                  ? server::kDemoName
                                  : std::filesystem::path(args->mesh).filename().string();
     std::cerr << name << ": " << mesh.mesh.num_vertices()
-              << " vertices; preparing m = " << args->editor.modes << " manifold harmonics\n";
-    editor.session().open(std::move(mesh), name);
+              << " vertices; preparing m = " << args->editor.modes
+              << " manifold harmonics (the page shows the progress)\n";
+    editor.open_when_running(std::move(mesh), name);
     std::cout << "specdeform editor: " << editor.url() << "  (Ctrl-C stops it)" << std::endl;
     editor.run();
   });

@@ -136,12 +136,15 @@ struct EditorServer::Impl {
   std::unique_ptr<EditorSession> session;
   std::mutex connection_mutex;
   std::shared_ptr<Connection> connection;  // the editor window being served
+  std::string progress;                    // the last progress message while one is running
 
   void send(bool binary, std::string data) {
     std::shared_ptr<Connection> c;
     {
       std::lock_guard lock(connection_mutex);
       c = connection;
+      const bool is_progress = !binary && data.starts_with(R"({"type":"progress")");
+      progress = is_progress ? data : std::string();
     }
     if (c) c->send(binary, std::move(data));
   }
@@ -151,6 +154,7 @@ struct EditorServer::Impl {
     {
       std::lock_guard lock(connection_mutex);
       previous = std::exchange(connection, c);
+      if (!progress.empty()) c->send(false, progress);
     }
     if (previous) previous->close("another editor window connected");
   }
@@ -214,6 +218,10 @@ struct EditorServer::Impl {
         co_await c->ws().async_read(buffer, use_awaitable);
         const bool binary = c->ws().got_binary();
         auto data = std::make_shared<std::string>(beast::buffers_to_string(buffer.data()));
+        if (!binary && *data == R"({"type":"cancel"})") {
+          session->cancel();  // at once: the worker is busy with what it cancels
+          continue;
+        }
         const bool frame = binary && data->size() >= 4 && message_tag(*data) == Tag::Frame;
         mailbox.push([this, binary, data] { session->handle(binary, *data); }, frame);
       }
@@ -302,6 +310,15 @@ EditorSession& EditorServer::session() {
   return *impl_->session;
 }
 
+void EditorServer::open_when_running(LoadedMesh mesh, std::string name) {
+  auto job = [this, mesh = std::make_shared<LoadedMesh>(std::move(mesh)), name] {
+    if (auto error = impl_->session->start(std::move(*mesh), name)) {
+      std::cerr << "specdeform: " << *error << "\n";
+    }
+  };
+  impl_->mailbox.push(std::move(job), false);
+}
+
 uint16_t EditorServer::port() const {
   return impl_->acceptor.local_endpoint().port();
 }
@@ -320,13 +337,7 @@ std::string EditorServer::url() const {
 void EditorServer::run() {
   Impl& s = *impl_;
   std::thread worker([&s] {
-    while (std::optional<Mailbox::Job> job = s.mailbox.pop()) {
-      try {
-        (*job)();
-      } catch (const Cancelled&) {
-        return;
-      }
-    }
+    while (std::optional<Mailbox::Job> job = s.mailbox.pop()) (*job)();
   });
   s.signals.async_wait([this](beast::error_code, int) { stop(); });
   net::co_spawn(s.io, s.listen(), net::detached);

@@ -6,6 +6,8 @@
 // - Serves exactly the files found under the assets folder at start-up, read into memory, and
 //   nothing else (no path traversal, no symbolic links followed).
 // - One editor window at a time: a new connection takes over and the previous one is closed.
+// - A "cancel" message is acted on as it arrives (EditorSession::cancel), not queued; a window
+//   that connects while the basis is computed gets the latest progress at once.
 // - Incoming messages run on one worker thread through a Mailbox (frames coalesce, latest
 //   wins); outgoing frame results that have not started to go out are replaced by newer ones,
 //   so neither direction lets the editor fall behind.
@@ -37,6 +39,11 @@ class EditorServer {
   // The session the browser talks to. Open its first mesh here before run(); from run() on it
   // belongs to the server's worker thread.
   EditorSession& session();
+
+  // Opens the first mesh on the worker thread once run() starts, so that the page is served
+  // (and shows the basis's progress) while it is prepared; a failure is reported to the page
+  // and on stderr, and the page offers to open another mesh.
+  void open_when_running(LoadedMesh mesh, std::string name);
 
   uint16_t port() const;
   std::string url() const;

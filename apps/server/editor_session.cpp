@@ -1,13 +1,17 @@
 #include "editor_session.h"
 
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <new>
 
 #include <nlohmann/json.hpp>
 
-#include "protocol.h"
+#include "pose.h"
+#include "preview.h"
 #include "specdeform/deform/scene.h"
 #include "specdeform/mesh/generate.h"
 #include "specdeform/spectral/basis_cache.h"
@@ -31,34 +35,107 @@ double seconds_since(Clock::time_point t) {
 // The largest basis residual (eigen_residual) the editor works with, warning, when the solver
 // falls short of its tolerance.
 constexpr double kUsableResidual = 1e-6;
+// Undo steps kept, and poses whose basis stays in memory (older ones are computed again, or
+// loaded from the cache, when an undo returns to them).
+constexpr size_t kHistory = 200;
+constexpr int kPoseBases = 3;
+
+std::string hex(uint64_t v) {
+  char s[17];
+  std::snprintf(s, sizeof s, "%016llx", static_cast<unsigned long long>(v));
+  return s;
+}
 
 std::filesystem::path cache_file(const std::filesystem::path& dir, const TriangleMesh& mesh,
                                  int modes, MassType mass) {
-  char hash[17];
-  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(mesh_hash(mesh)));
-  return dir / (std::string(hash) + "-m" + std::to_string(modes) +
+  return dir / (hex(mesh_hash(mesh)) + "-m" + std::to_string(modes) +
                 (mass == MassType::Lumped ? "-lumped" : "-consistent") + ".sdbasis");
+}
+
+Json matrix(const Eigen::Affine3d& t) {
+  Json out = Json::array();
+  for (int i = 0; i < 16; ++i) out.push_back(t.matrix()(i / 4, i % 4));
+  return out;
+}
+
+const char* tag_name(Tag tag) {
+  switch (tag) {
+    case Tag::Selection:
+      return "selection";
+    case Tag::Frame:
+      return "frame";
+    case Tag::MeshFile:
+      return "mesh_file";
+    case Tag::SelectionFile:
+      return "selection_file";
+    case Tag::SceneFile:
+      return "scene_file";
+    default:
+      return "binary";
+  }
+}
+
+// A scene uploaded by the browser names its vertices itself: files it would refer to are not
+// the browser's to open on the server's disk.
+void check_self_contained(const std::string& text, const std::string& name) {
+  const Json j = Json::parse(text, nullptr, false);
+  if (!j.is_object()) throw InputError(name + ": not a JSON object");
+  const auto refers = [](const Json& item) {
+    return item.is_object() && item.contains("selection");
+  };
+  bool refers_to_file = j.contains("fixed") && refers(j["fixed"]);
+  if (j.contains("handles") && j["handles"].is_array()) {
+    for (const Json& h : j["handles"]) refers_to_file = refers_to_file || refers(h);
+  }
+  if (refers_to_file) {
+    throw InputError(name +
+                     ": a scene opened in the editor must list its vertices (a "
+                     "\"selection\" file cannot be read from the browser)");
+  }
 }
 
 }  // namespace
 
+struct EditorSession::Basis {
+  std::shared_ptr<const ManifoldHarmonics> harmonics;  // null: to be computed again
+  double seconds = 0.0;
+  std::string source;   // computed, cache, reused
+  std::string warning;  // shown to the user
+};
+
+struct Pose {
+  Vertices rest;
+  std::string id;  // mesh_hash of the rest shape
+};
+
+struct Entry {  // one undo step
+  GroupSelection edit;
+  int pose = 0;
+};
+
 struct EditorSession::State {
-  LoadedMesh loaded;
+  LoadedMesh loaded;  // as read: the file's numbering, and the first pose's positions
   std::string name;
+  std::vector<Pose> poses;
+  std::vector<Basis> bases;  // of each pose
+  int pose = 0;
   double diagonal = 1.0;
   int modes = 100;
   DeformOptions options;
   bool base_view = false;
-  std::shared_ptr<const ManifoldHarmonics> basis;
-  double basis_seconds = 0.0;
-  bool basis_from_cache = false;
-  std::string warning;  // about the basis, shown to the user
   std::optional<SpectralDeformer> deformer;
-  Selection selection;
+  GroupSelection edit;
   bool has_handles = false;
-  std::vector<Eigen::Affine3d> transforms;
+  std::vector<Entry> history;
+  size_t at = 0;
   uint32_t seq = 0;
-  Vertices result;  // the last detailed result (the rest positions before any frame)
+  Vertices result;  // the last detailed result (the rest shape before any frame)
+  std::optional<PreviewMesh> preview;
+  double selection_seconds = 0.0, pin_error = 0.0;
+
+  const Vertices& rest() const { return poses[pose].rest; }
+  TriangleMesh rest_mesh(int p) const { return {poses[p].rest, loaded.mesh.F}; }
+  const Basis& basis() const { return bases[pose]; }
 };
 
 LoadedMesh demo_mesh() {
@@ -73,25 +150,49 @@ EditorSession::EditorSession(EditorConfig config, Send send)
 
 EditorSession::~EditorSession() = default;
 
-void EditorSession::send_error(const std::string& message) {
-  send_(false, dump(Json{{"type", "error"}, {"message", message}}));
+void EditorSession::send_error(const std::string& message, bool cancelled) {
+  send_(false, dump(Json{{"type", "error"},
+                         {"message", message},
+                         {"request", request_},
+                         {"cancelled", cancelled}}));
 }
 
 void EditorSession::handle(bool binary, std::string_view message) {
-  try {
-    dispatch(binary, message);
-  } catch (const Cancelled&) {
-    throw;
-  } catch (const std::bad_alloc&) {
-    send_error("out of memory");
-  } catch (const std::exception& e) {
-    send_error(e.what());
+  request_ = binary ? "binary" : "text";
+  // The browser shows the settings in force again after a rejected change.
+  if (!answer([&] { dispatch(binary, message); }) && request_ == "settings" && state_) {
+    send_ready();
   }
+}
+
+std::optional<std::string> EditorSession::start(LoadedMesh mesh, std::string name) {
+  request_ = "open";
+  if (answer([&] { open(std::move(mesh), std::move(name)); })) return std::nullopt;
+  if (!state_) send_(false, dump({{"type", "empty"}}));
+  return last_error_;
+}
+
+bool EditorSession::answer(const std::function<void()>& work) {
+  try {
+    work();
+    return true;
+  } catch (const Cancelled&) {
+    last_error_ = state_ ? "cancelled: nothing changed" : "cancelled: no mesh is open";
+    send_error(last_error_, true);
+  } catch (const std::bad_alloc&) {
+    last_error_ = "out of memory";
+    send_error(last_error_);
+  } catch (const std::exception& e) {
+    last_error_ = e.what();
+    send_error(last_error_);
+  }
+  return false;
 }
 
 void EditorSession::dispatch(bool binary, std::string_view message) {
   if (!binary) return text_message(message);
   const Tag tag = message_tag(message);
+  request_ = tag_name(tag);
   if (tag == Tag::MeshFile) {
     NamedFile file = decode_file(message);
     const std::filesystem::path name = std::filesystem::path(file.name).filename();
@@ -103,13 +204,15 @@ void EditorSession::dispatch(bool binary, std::string_view message) {
   const int n = s.loaded.mesh.num_vertices();
   switch (tag) {
     case Tag::Selection:
-      return set_selection(decode_selection(message, n));
+      return set_edit(decode_selection(message, n), true);
     case Tag::Frame: {
       if (!s.has_handles) throw InputError("frame message: select a handle first");
-      FrameRequest f = decode_frame(message, static_cast<int>(s.selection.handles.size()));
-      s.transforms = std::move(f.transforms);
+      const FrameRequest f = decode_frame(message, static_cast<int>(s.edit.transforms.size()));
+      for (size_t g = 0; g < f.transforms.size(); ++g) {
+        if (!s.edit.pinned[g]) s.edit.transforms[g] = f.transforms[g];
+      }
       s.seq = f.seq;
-      return solve_and_send();
+      return solve_and_send(f.preview);
     }
     case Tag::SelectionFile: {
       const NamedFile file = decode_file(message);
@@ -120,8 +223,17 @@ void EditorSession::dispatch(bool binary, std::string_view message) {
       }
       const Selection in_file = is_sel ? parse_sel(file.data, file_vertices, file.name)
                                        : parse_dmat(file.data, file_vertices, file.name);
-      return send_(true, encode_selection(to_mesh_numbering(in_file, s.loaded.info)));
+      GroupSelection edit;
+      edit.selection = to_mesh_numbering(in_file, s.loaded.info);
+      const size_t groups = edit.selection.handles.size();
+      edit.transforms.assign(groups, Eigen::Affine3d::Identity());
+      edit.pinned.assign(groups, false);
+      edit.fit.assign(groups, false);
+      set_edit(std::move(edit), true);
+      return send_selection();
     }
+    case Tag::SceneFile:
+      return open_scene(decode_file(message));
     default:
       throw InputError("binary message: unknown tag " + std::to_string(static_cast<uint32_t>(tag)));
   }
@@ -133,60 +245,41 @@ void EditorSession::text_message(std::string_view message) {
     throw InputError("text message: expected a JSON object with a \"type\"");
   }
   const std::string type = j["type"];
-  if (type == "open_demo") {
-    return open(demo_mesh(), kDemoName);
-  }
+  request_ = type;
+  if (type == "open_demo") return open(demo_mesh(), kDemoName);
+  if (type == "hello" && !state_) return send_(false, dump({{"type", "empty"}}));
+  if (type == "cancel") return;  // nothing runs: there is nothing to cancel
   if (!state_) throw InputError("no mesh is open");
   State& s = *state_;
-  if (type == "hello") return send_state();
-  if (type == "settings") {
-    const auto number = [&](const char* key, double lo, double hi) -> std::optional<double> {
-      if (!j.contains(key)) return std::nullopt;
-      if (!j[key].is_number() || !(j[key].get<double>() >= lo && j[key].get<double>() <= hi)) {
-        throw InputError(std::string("settings: ") + key + " must be a number in [" +
-                         std::to_string(lo) + ", " + std::to_string(hi) + "]");
-      }
-      return j[key].get<double>();
-    };
-    const auto word = [&](const char* key) -> std::optional<std::string> {
-      if (!j.contains(key)) return std::nullopt;
-      if (!j[key].is_string()) throw InputError(std::string("settings: ") + key + " is a string");
-      return j[key].get<std::string>();
-    };
-    DeformOptions o = s.options;
-    int modes = s.modes;
-    bool base_view = s.base_view;
-    if (auto v = number("modes", 1, 5000)) modes = static_cast<int>(*v);
-    if (auto v = number("ks", 0, 1e6)) o.ks = *v;
-    if (auto v = number("kb", 0, 1e6)) o.kb = *v;
-    if (auto v = word("energy")) o.energy = deform_energy_from_name(*v);
-    if (auto v = word("detail")) o.detail = detail_method_from_name(*v);
-    if (auto v = word("constraints")) o.constraints = constraint_mode_from_name(*v);
-    if (auto v = word("view")) {
-      if (*v != "detailed" && *v != "base") throw InputError("settings: view is detailed or base");
-      base_view = *v == "base";
+  if (type == "hello") {
+    send_mesh();
+    send_ready();
+    send_selection();
+    send_state();
+    if (s.has_handles) solve_and_send();
+    return;
+  }
+  if (type == "settings") return change_settings(message);
+  if (type == "commit") {
+    commit();
+    return send_state();
+  }
+  if (type == "undo" || type == "redo") {
+    const bool undo = type == "undo";
+    if (undo ? s.at == 0 : s.at + 1 >= s.history.size()) {
+      throw InputError(undo ? "nothing to undo" : "nothing to redo");
     }
-    try {
-      o.validate();
-    } catch (const InputError& e) {
-      throw InputError(std::string("settings: ") + e.what());
+    return restore(undo ? s.at - 1 : s.at + 1);
+  }
+  if (type == "apply_pose") return apply_pose();
+  if (type == "preview") {
+    if (!j.contains("vertices") || !j["vertices"].is_number_integer()) {
+      throw InputError("preview: \"vertices\" is a whole number");
     }
-    if (modes >= s.loaded.mesh.num_vertices()) {
-      throw InputError("settings: m must be below the vertex count (" +
-                       std::to_string(s.loaded.mesh.num_vertices()) + ")");
-    }
-    const bool new_basis = modes != s.modes;
-    const bool new_deformer = new_basis || o.energy != s.options.energy || o.ks != s.options.ks ||
-                              o.kb != s.options.kb || o.detail != s.options.detail ||
-                              o.constraints != s.options.constraints;
-    s.base_view = base_view;
-    if (new_deformer) {
-      build(s.loaded, s.name, modes, o, new_basis ? nullptr : s.basis);
-      config_.modes = modes;  // meshes opened later start with these settings too
-      config_.options = o;
-      return;
-    }
-    return solve_and_send();
+    const int64_t k = j["vertices"].get<int64_t>();
+    s.preview = make_preview(s.rest_mesh(s.pose),
+                             static_cast<int>(std::clamp<int64_t>(k, 0, s.rest().rows())));
+    return send_(true, encode_preview(*s.preview));
   }
   if (type == "export_mesh") {
     const std::string format = j.value("format", "obj");
@@ -197,20 +290,25 @@ void EditorSession::text_message(std::string_view message) {
                  encode_file({out.string(), encode_mesh(file_order, mesh_format_from_path(out))}));
   }
   if (type == "export_scene") {
+    if (s.pose > 0) {
+      throw InputError(
+          "export scene: a scene moves the file's shape, and a pose was applied "
+          "since (export the mesh, or undo to before the pose)");
+    }
     Scene scene;
     scene.mesh = s.name;
     scene.modes = s.modes;
     scene.options = s.options;
     const std::vector<int>& to_file = s.loaded.info.vertex_to_file;
-    for (size_t g = 0; g < s.selection.handles.size(); ++g) {
-      if (s.selection.handles[g].empty()) continue;
+    const Selection& selection = s.edit.selection;
+    for (size_t g = 0; g < selection.handles.size(); ++g) {
+      if (selection.handles[g].empty()) continue;
       std::vector<int> group;
-      for (int v : s.selection.handles[g]) group.push_back(to_file[v]);
+      for (int v : selection.handles[g]) group.push_back(to_file[v]);
       scene.selection.handles.push_back(std::move(group));
-      scene.transforms.push_back(g < s.transforms.size() ? s.transforms[g]
-                                                         : Eigen::Affine3d::Identity());
+      scene.transforms.push_back(s.edit.transforms[g]);
     }
-    for (int v : s.selection.fixed) scene.selection.fixed.push_back(to_file[v]);
+    for (int v : selection.fixed) scene.selection.fixed.push_back(to_file[v]);
     if (scene.selection.handles.empty()) throw InputError("export: select a handle first");
     const std::string out = std::filesystem::path(s.name).stem().string() + "-scene.json";
     return send_(true, encode_file({out, encode_scene(scene)}));
@@ -218,101 +316,329 @@ void EditorSession::text_message(std::string_view message) {
   throw InputError("text message: unknown type '" + type + "'");
 }
 
-void EditorSession::open(LoadedMesh mesh, std::string name) {
-  build(std::move(mesh), std::move(name), config_.modes, config_.options, nullptr);
+void EditorSession::change_settings(std::string_view message) {
+  State& s = *state_;
+  const Json j = Json::parse(message);
+  const auto number = [&](const char* key, double lo, double hi) -> std::optional<double> {
+    if (!j.contains(key)) return std::nullopt;
+    if (!j[key].is_number() || !(j[key].get<double>() >= lo && j[key].get<double>() <= hi)) {
+      throw InputError(std::string("settings: ") + key + " must be a number in [" +
+                       std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    }
+    return j[key].get<double>();
+  };
+  const auto word = [&](const char* key) -> std::optional<std::string> {
+    if (!j.contains(key)) return std::nullopt;
+    if (!j[key].is_string()) throw InputError(std::string("settings: ") + key + " is a string");
+    return j[key].get<std::string>();
+  };
+  DeformOptions o = s.options;
+  int modes = s.modes;
+  bool base_view = s.base_view;
+  if (auto v = number("modes", 1, 5000)) modes = static_cast<int>(*v);
+  if (auto v = number("ks", 0, 1e6)) o.ks = *v;
+  if (auto v = number("kb", 0, 1e6)) o.kb = *v;
+  if (auto v = word("energy")) o.energy = deform_energy_from_name(*v);
+  if (auto v = word("detail")) o.detail = detail_method_from_name(*v);
+  if (auto v = word("constraints")) o.constraints = constraint_mode_from_name(*v);
+  if (auto v = word("view")) {
+    if (*v != "detailed" && *v != "base") throw InputError("settings: view is detailed or base");
+    base_view = *v == "base";
+  }
+  try {
+    o.validate();
+  } catch (const InputError& e) {
+    throw InputError(std::string("settings: ") + e.what());
+  }
+  if (modes >= s.loaded.mesh.num_vertices()) {
+    throw InputError("settings: m must be below the vertex count (" +
+                     std::to_string(s.loaded.mesh.num_vertices()) + ")");
+  }
+  const bool new_basis = modes != s.modes;
+  const bool new_deformer = new_basis || o.energy != s.options.energy || o.ks != s.options.ks ||
+                            o.kb != s.options.kb || o.detail != s.options.detail ||
+                            o.constraints != s.options.constraints;
+  if (new_deformer) {
+    const Basis basis = new_basis ? compute_basis(s.rest_mesh(s.pose), modes) : s.basis();
+    SpectralDeformer deformer(s.rest_mesh(s.pose), basis.harmonics, o);
+    if (s.has_handles) deformer.set_selection(s.edit.selection);
+    s.deformer.emplace(std::move(deformer));
+    if (new_basis) {  // the other poses' bases have the old m
+      for (Basis& b : s.bases) b.harmonics.reset();
+      s.bases[s.pose] = basis;
+    }
+    s.modes = modes;
+    s.options = o;
+    config_.modes = modes;  // meshes opened later start with these settings too
+    config_.options = o;
+  }
+  s.base_view = base_view;
+  send_ready();
+  solve_and_send();
 }
 
-void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
-                          const DeformOptions& options,
-                          std::shared_ptr<const ManifoldHarmonics> reuse_basis) {
-  cancelled_ = false;
-  auto next = std::make_unique<State>();
-  State& s = *next;
-  s.modes = modes;
-  s.options = options;
-  const int n = mesh.mesh.num_vertices();
-  if (n < 4) throw InputError(name + ": too few vertices to deform");
-  if (s.modes >= n) s.modes = n - 1;
+void EditorSession::set_edit(GroupSelection edit, bool record) {
+  State& s = *state_;
+  const size_t groups = edit.selection.handles.size();
+  if (edit.transforms.size() != groups || edit.pinned.size() != groups) {
+    throw InputError("selection: one transform and one flag per group");
+  }
+  edit.fit.resize(groups, false);
+  double pin_error = 0.0;
+  for (size_t g = 0; g < groups; ++g) {
+    if (!edit.fit[g] || !edit.pinned[g] || edit.selection.handles[g].empty()) continue;
+    const FittedTransform fit = fit_transform(s.rest(), s.result, edit.selection.handles[g]);
+    edit.transforms[g] = fit.transform;
+    pin_error = std::max(pin_error, fit.max_error / s.diagonal);
+  }
+  edit.fit.assign(groups, false);
+  size_t handle_vertices = 0;
+  for (const auto& g : edit.selection.handles) handle_vertices += g.size();
+  const Clock::time_point start = Clock::now();
+  if (handle_vertices > 0) {
+    try {
+      s.deformer->set_selection(edit.selection);
+    } catch (...) {
+      if (s.has_handles) s.deformer->set_selection(s.edit.selection);
+      throw;
+    }
+  }
+  s.selection_seconds = seconds_since(start);
+  s.pin_error = pin_error;
+  s.has_handles = handle_vertices > 0;
+  s.edit = std::move(edit);
+  if (!s.has_handles) s.result = s.rest();
+  if (record) push_history();
+  send_state();
+  if (s.has_handles) solve_and_send();
+}
 
+void EditorSession::push_history() {
+  State& s = *state_;
+  s.history.resize(s.at + 1);
+  s.history.push_back({s.edit, s.pose});
+  if (s.history.size() > kHistory) s.history.erase(s.history.begin());
+  s.at = s.history.size() - 1;
+}
+
+void EditorSession::commit() {
+  const State& s = *state_;
+  const auto& before = s.history[s.at].edit.transforms;
+  const bool moved = !std::equal(
+      before.begin(), before.end(), s.edit.transforms.begin(), s.edit.transforms.end(),
+      [](const Eigen::Affine3d& a, const Eigen::Affine3d& b) { return a.matrix() == b.matrix(); });
+  if (moved) push_history();
+}
+
+void EditorSession::restore(size_t entry) {
+  State& s = *state_;
+  const Entry& e = s.history[entry];
+  if (e.pose != s.pose) {
+    Basis& basis = s.bases[e.pose];
+    if (!basis.harmonics) basis = compute_basis(s.rest_mesh(e.pose), s.modes);
+    SpectralDeformer deformer(s.rest_mesh(e.pose), basis.harmonics, s.options);
+    s.deformer.emplace(std::move(deformer));
+    s.pose = e.pose;
+    s.has_handles = false;
+    s.result = s.rest();
+    send_mesh();
+    send_ready();
+  }
+  s.at = entry;
+  set_edit(s.history[entry].edit, false);
+  send_selection();
+}
+
+void EditorSession::apply_pose() {
+  State& s = *state_;
+  if (!s.has_handles) throw InputError("apply pose: nothing is moved yet (drag a handle first)");
+  const TriangleMesh posed{s.result, s.loaded.mesh.F};
+  Basis basis;
+  const Clock::time_point start = Clock::now();
+  auto reused = std::make_shared<ManifoldHarmonics>(reuse_basis(posed, *s.basis().harmonics));
+  if (reused->max_residual <= kReuseResidual) {
+    basis.seconds = seconds_since(start);
+    basis.source = "reused";
+    basis.harmonics = std::move(reused);
+  } else {
+    reused.reset();
+    basis = compute_basis(posed, s.modes);
+  }
+  SpectralDeformer deformer(posed, basis.harmonics, s.options);
+  commit();  // undo returns to the pose as it was dragged
+  // Handles keep their vertices from here; pins become fixed where they are.
+  GroupSelection edit;
+  edit.selection.fixed = s.edit.selection.fixed;
+  for (size_t g = 0; g < s.edit.selection.handles.size(); ++g) {
+    const std::vector<int>& group = s.edit.selection.handles[g];
+    if (s.edit.pinned[g]) {
+      edit.selection.fixed.insert(edit.selection.fixed.end(), group.begin(), group.end());
+      continue;
+    }
+    edit.selection.handles.push_back(group);
+    edit.transforms.push_back(Eigen::Affine3d::Identity());
+    edit.pinned.push_back(false);
+  }
+  s.deformer.emplace(std::move(deformer));
+  s.poses.push_back({posed.V, hex(mesh_hash(posed))});
+  s.bases.push_back(std::move(basis));
+  for (int p = 0; p + kPoseBases < static_cast<int>(s.bases.size()); ++p) {
+    s.bases[p].harmonics.reset();
+  }
+  s.pose = static_cast<int>(s.poses.size()) - 1;
+  s.has_handles = false;
+  s.result = s.rest();
+  send_mesh();
+  send_ready();
+  set_edit(std::move(edit), true);
+  send_selection();
+}
+
+void EditorSession::open_scene(const NamedFile& file) {
+  State& s = *state_;
+  if (s.pose > 0) {
+    throw InputError(file.name +
+                     ": a scene moves the file's shape, and a pose was applied (undo "
+                     "to before it, or open the mesh again)");
+  }
+  check_self_contained(file.data, file.name);
+  const std::filesystem::path path = std::filesystem::temp_directory_path() /
+                                     ("specdeform-scene-" + std::to_string(::getpid()) + ".json");
+  std::ofstream(path, std::ios::binary) << file.data;
+  Scene scene;
+  try {
+    scene = read_scene(path, s.loaded.info.file_vertices, s.options);
+  } catch (...) {
+    std::filesystem::remove(path);
+    throw;
+  }
+  std::filesystem::remove(path);
+  GroupSelection edit;
+  edit.selection = to_mesh_numbering(scene.selection, s.loaded.info);
+  edit.transforms = match_transforms(edit.selection, scene.transforms);
+  edit.pinned.assign(edit.selection.handles.size(), false);
+  // The scene's settings, as a settings request would set them.
+  DeformOptions o = scene.options;
+  o.float32_basis = s.options.float32_basis;
+  o.arap.warm_start = s.options.arap.warm_start;
+  Json settings = {{"type", "settings"},
+                   {"modes", scene.modes.value_or(s.modes)},
+                   {"energy", name(o.energy)},
+                   {"ks", o.ks},
+                   {"kb", o.kb},
+                   {"detail", name(o.detail)},
+                   {"constraints", name(o.constraints)}};
+  change_settings(dump(settings));
+  set_edit(std::move(edit), true);
+  send_selection();
+}
+
+void EditorSession::open(LoadedMesh mesh, std::string name) {
+  build(std::move(mesh), std::move(name), config_.modes, config_.options);
+}
+
+EditorSession::Basis EditorSession::compute_basis(const TriangleMesh& mesh, int modes) {
+  struct Computing {
+    std::atomic<bool>& flag;
+    explicit Computing(std::atomic<bool>& f) : flag(f) { flag = true; }
+    ~Computing() { flag = false; }
+  } computing(computing_);
+  cancelled_ = false;
   Clock::time_point last_report{};
   const auto report = [&](double fraction, std::string_view stage) {
     if (cancelled_) throw Cancelled();
     if (seconds_since(last_report) < 0.1 && fraction < 1.0) return;
     last_report = Clock::now();
-    send_(false, dump({{"type", "progress"}, {"stage", stage}, {"fraction", fraction}}));
+    send_(false, dump({{"type", "progress"},
+                       {"stage", stage},
+                       {"fraction", fraction},
+                       {"cancellable", true}}));
   };
+  Basis out;
   const Clock::time_point start = Clock::now();
   const std::filesystem::path cache =
-      config_.cache_dir.empty()
-          ? std::filesystem::path()
-          : cache_file(config_.cache_dir, mesh.mesh, s.modes, MassType::Lumped);
-  const bool reused = reuse_basis != nullptr;
-  if (reused) {
-    s.basis = std::move(reuse_basis);
-    s.basis_seconds = state_->basis_seconds;
-    s.basis_from_cache = state_->basis_from_cache;
-    s.warning = state_->warning;
-  } else if (!cache.empty() && std::filesystem::exists(cache)) {
+      config_.cache_dir.empty() ? std::filesystem::path()
+                                : cache_file(config_.cache_dir, mesh, modes, MassType::Lumped);
+  if (!cache.empty() && std::filesystem::exists(cache)) {
     report(0.0, "loading the basis");
-    s.basis = std::make_shared<const ManifoldHarmonics>(load_basis(cache, mesh.mesh));
-    s.basis_from_cache = true;
+    out.harmonics = std::make_shared<const ManifoldHarmonics>(load_basis(cache, mesh));
+    out.source = "cache";
   } else {
     ManifoldHarmonicsOptions o;
-    o.num_modes = s.modes;
+    o.num_modes = modes;
     o.progress = report;
-    auto basis = std::make_shared<ManifoldHarmonics>(compute_manifold_harmonics(mesh.mesh, o));
-    s.basis = basis;
+    auto basis = std::make_shared<ManifoldHarmonics>(compute_manifold_harmonics(mesh, o));
+    out.harmonics = basis;
+    out.source = "computed";
     if (basis->status != SolveStatus::Converged) {
       // Short of the tolerance but far below what a deformation can show (nearly degenerate
       // triangles limit the attainable accuracy): usable, with a warning; not cached.
       if (!(basis->max_residual <= kUsableResidual)) {
-        throw SolverError(name + ": the manifold harmonics did not converge: " +
+        throw SolverError("the manifold harmonics did not converge: " +
                           residual_summary(*basis, o.tolerance));
       }
-      s.warning = "the basis is less accurate than asked: " + residual_summary(*basis, o.tolerance);
+      out.warning =
+          "the basis is less accurate than asked: " + residual_summary(*basis, o.tolerance);
     } else if (!cache.empty()) {
       try {
         std::filesystem::create_directories(cache.parent_path());
-        save_basis(cache, *basis, mesh.mesh, BasisPrecision::Float64);
+        save_basis(cache, *basis, mesh, BasisPrecision::Float64);
       } catch (const std::exception& e) {
         std::cerr << "specdeform: warning: basis not cached: " << e.what() << "\n";
       }
     }
   }
-  if (!reused) s.basis_seconds = seconds_since(start);
+  out.seconds = seconds_since(start);
   report(1.0, "factorizing");
-  s.deformer.emplace(mesh.mesh, s.basis, s.options);
+  return out;
+}
+
+void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
+                          const DeformOptions& options) {
+  const int n = mesh.mesh.num_vertices();
+  if (n < 4) throw InputError(name + ": too few vertices to deform");
+  auto next = std::make_unique<State>();
+  State& s = *next;
+  s.modes = std::min(modes, n - 1);
+  s.options = options;
+  Basis basis;
+  try {
+    basis = compute_basis(mesh.mesh, s.modes);
+  } catch (const SolverError& e) {
+    throw SolverError(name + ": " + e.what());
+  }
+  s.deformer.emplace(mesh.mesh, basis.harmonics, s.options);
+  s.bases.push_back(std::move(basis));
+  s.poses.push_back({mesh.mesh.V, hex(mesh_hash(mesh.mesh))});
   s.loaded = std::move(mesh);
   s.name = std::move(name);
-  s.result = s.loaded.mesh.V;
-  const Vertices& V = s.loaded.mesh.V;
-  s.diagonal = bounding_box_diagonal(V);
-  // Settings changes reopen the same mesh: keep the selection and the handles' transforms.
-  if (state_ && state_->loaded.mesh.V.rows() == V.rows() &&
-      state_->loaded.mesh.F == s.loaded.mesh.F && state_->loaded.mesh.V == V) {
-    s.selection = state_->selection;
-    s.transforms = state_->transforms;
-    s.seq = state_->seq;
-    s.base_view = state_->base_view;
-    if (state_->has_handles) {
-      s.deformer->set_selection(s.selection);
-      s.has_handles = true;
-    }
-  }
+  s.result = s.rest();
+  s.diagonal = bounding_box_diagonal(s.rest());
+  s.history.push_back({s.edit, 0});
   state_ = std::move(next);
+  send_mesh();
+  send_ready();
+  send_selection();
   send_state();
 }
 
-void EditorSession::send_state() {
-  State& s = *state_;
-  send_(true, encode_mesh_message(s.loaded.mesh));
+void EditorSession::send_mesh() {
+  const State& s = *state_;
+  send_(true, encode_mesh_message(s.rest_mesh(s.pose)));
+}
+
+void EditorSession::send_ready() {
+  const State& s = *state_;
   const SetupTimings& t = s.deformer->setup_timings();
+  const Basis& b = s.basis();
   send_(false, dump(Json{{"type", "ready"},
                          {"name", s.name},
                          {"vertices", s.loaded.mesh.num_vertices()},
                          {"faces", s.loaded.mesh.num_faces()},
                          {"diagonal", s.diagonal},
+                         {"mesh_id", s.poses[s.pose].id},
                          {"modes", s.modes},
+                         {"pose", s.pose},
                          {"settings",
                           {{"energy", name(s.options.energy)},
                            {"ks", s.options.ks},
@@ -321,46 +647,58 @@ void EditorSession::send_state() {
                            {"constraints", name(s.options.constraints)},
                            {"view", s.base_view ? "base" : "detailed"}}},
                          {"basis",
-                          {{"seconds", s.basis_seconds},
-                           {"source", s.basis_from_cache ? "cache" : "computed"},
-                           {"residual", s.basis->max_residual},
-                           {"warning", s.warning}}},
+                          {{"seconds", b.seconds},
+                           {"source", b.source},
+                           {"residual", b.harmonics->max_residual},
+                           {"warning", b.warning}}},
                          {"setup",
                           {{"reduced_system", t.reduced_system},
                            {"detail_factorization", t.detail_factorization},
-                           {"selection", t.selection}}}}));
-  if (s.has_handles) solve_and_send();
+                           {"selection", t.selection}}},
+                         {"arap_clusters", s.deformer->rotation_clusters()}}));
 }
 
-void EditorSession::set_selection(Selection selection) {
-  State& s = *state_;
-  size_t handle_vertices = 0;
-  for (const auto& g : selection.handles) handle_vertices += g.size();
-  const Clock::time_point start = Clock::now();
-  if (handle_vertices > 0) s.deformer->set_selection(selection);
-  s.has_handles = handle_vertices > 0;
-  s.selection = std::move(selection);
-  s.transforms.assign(s.selection.handles.size(), Eigen::Affine3d::Identity());
-  if (!s.has_handles) s.result = s.loaded.mesh.V;
-  Json sizes = Json::array();
-  for (const auto& g : s.selection.handles) sizes.push_back(g.size());
-  send_(false, dump({{"type", "selection"},
-                     {"handles", sizes},
-                     {"fixed", s.selection.fixed.size()},
-                     {"seconds", seconds_since(start)}}));
+void EditorSession::send_selection() {
+  send_(true, encode_selection(state_->edit));
 }
 
-void EditorSession::solve_and_send() {
-  State& s = *state_;
-  if (!s.has_handles) {
-    return send_(true, encode_frame_result(s.seq, s.base_view, {}, s.loaded.mesh.V));
+void EditorSession::send_state() {
+  const State& s = *state_;
+  Json groups = Json::array();
+  for (size_t g = 0; g < s.edit.selection.handles.size(); ++g) {
+    groups.push_back({{"vertices", s.edit.selection.handles[g].size()},
+                      {"pinned", static_cast<bool>(s.edit.pinned[g])},
+                      {"transform", matrix(s.edit.transforms[g])}});
   }
-  s.result = s.deformer->solve(s.transforms);
+  send_(false, dump({{"type", "state"},
+                     {"groups", groups},
+                     {"fixed", s.edit.selection.fixed.size()},
+                     {"undo", s.at > 0},
+                     {"redo", s.at + 1 < s.history.size()},
+                     {"selection_seconds", s.selection_seconds},
+                     {"pin_error", s.pin_error},
+                     {"held_pieces", s.has_handles ? s.deformer->held_pieces() : 0},
+                     {"pose", s.pose}}));
+}
+
+void EditorSession::solve_and_send(bool preview) {
+  State& s = *state_;
+  const FrameView view{s.base_view, preview && s.preview.has_value()};
+  const PreviewMesh* coarse = s.preview ? &*s.preview : nullptr;
+  if (!s.has_handles) {
+    return send_(true, encode_frame_result(s.seq, view, {}, s.rest(), coarse));
+  }
+  s.result = s.deformer->solve(s.edit.transforms);
   const FrameTimings& t = s.deformer->frame_timings();
   const ConstraintError e = s.deformer->constraint_error(s.result);
-  const FrameStats stats{t.reduced_solve, t.inverse_transform, t.detail, t.total, e.max, e.rms};
-  send_(true, encode_frame_result(s.seq, s.base_view, stats,
-                                  s.base_view ? s.deformer->deformed_base() : s.result));
+  const ArapReport& arap = s.deformer->arap_report();
+  const FrameStats stats{
+      t.reduced_solve, t.inverse_transform,
+      t.detail,        t.total,
+      e.max,           e.rms,
+      arap.iterations, s.options.energy == DeformEnergy::Linear || arap.converged};
+  send_(true, encode_frame_result(s.seq, view, stats,
+                                  s.base_view ? s.deformer->deformed_base() : s.result, coarse));
 }
 
 }  // namespace specdeform::server

@@ -1,32 +1,46 @@
-// What the browser editor edits: one mesh, its basis, a SpectralDeformer, the current selection
-// and handle transforms. Messages in, messages out (protocol.h), no networking; the server runs
-// it on one worker thread.
+// What the browser editor edits: one mesh, its basis, a SpectralDeformer, the handle groups with
+// their transforms, the poses applied and the history of edits. Messages in, messages out
+// (protocol.h), no networking; the server runs it on one worker thread. The session is the one
+// copy of the edit: a browser that connects (a reload, a second window) gets all of it back.
 //
 // Text messages (JSON objects with a "type"):
 //   browser -> server
-//     {"type": "hello"}                         resend the mesh and its state (a new connection)
+//     {"type": "hello"}              everything again (a new connection)
 //     {"type": "settings", "modes": m, "energy": "linear|arap", "ks": x, "kb": x,
 //      "detail": "none|displacement|frames|transfer", "constraints": "soft|hard",
-//      "view": "detailed|base"}   any subset
-//     {"type": "open_demo"}                     the built-in bumpy bar
+//      "view": "detailed|base"}      any subset; answered with "ready" (also when rejected)
+//     {"type": "open_demo"}          the built-in bumpy bar
+//     {"type": "commit"}             the transforms as they are now become an undo step
+//     {"type": "undo"}, {"type": "redo"}
+//     {"type": "apply_pose"}         the shown result becomes the rest shape (pins become fixed)
+//     {"type": "preview", "vertices": k}   a coarse mesh for drags (preview.h)
 //     {"type": "export_mesh", "format": "obj|off|ply|stl"}   answered with a file message
-//     {"type": "export_scene"}                  the scene JSON of `specdeform deform --scene`
+//     {"type": "export_scene"}       the scene JSON of `specdeform deform --scene`
+//     {"type": "cancel"}             handled by the server at once: see cancel()
 //   server -> browser
-//     {"type": "progress", "stage": s, "fraction": f}
-//     {"type": "ready", "name", "vertices", "faces", "diagonal", "modes", "settings",
-//      "basis": {"seconds", "source": "computed|cache", "residual"}, "setup": {...}}
-//     {"type": "selection", "handles": [sizes], "fixed": k, "seconds": s}
-//     {"type": "error", "message": one line}
-// A bad message is answered with an error and changes nothing.
+//     {"type": "progress", "stage": s, "fraction": f, "cancellable": b}
+//     {"type": "ready", "name", "vertices", "faces", "diagonal", "mesh_id", "modes", "settings",
+//      "pose", "basis": {"seconds", "source": "computed|cache|reused", "residual", "warning"},
+//      "setup": {...}, "arap_clusters"}         after a mesh message or a settings request
+//     {"type": "state", "groups": [{"vertices", "pinned", "transform": 16 numbers}], "fixed",
+//      "undo", "redo", "selection_seconds", "pin_error", "held_pieces", "pose"}
+//                                               after every edit (the terminal reply of one)
+//     {"type": "empty"}                         no mesh is open (a failed or cancelled start)
+//     {"type": "error", "message": one line, "request": the request's type, "cancelled": b}
+// Every request is answered: by its reply (ready, state, file, preview, a frame), or by an
+// error naming the request, after which nothing has changed; a rejected setting is followed by
+// "ready" with the settings in force.
 #pragma once
 
 #include <atomic>
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
+#include "protocol.h"
 #include "specdeform/deform/spectral_deformer.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/io.h"
@@ -60,6 +74,10 @@ class Cancelled : public Error {
 inline constexpr const char* kDemoName = "bumpy-bar.obj";
 LoadedMesh demo_mesh();
 
+// The largest eigen-residual of a reused basis that "apply_pose" accepts (pose.h): beyond it
+// the posed mesh's basis is computed.
+inline constexpr double kReuseResidual = 1e-2;
+
 class EditorSession {
  public:
   // `send(binary, data)` delivers one message to the browser.
@@ -69,29 +87,49 @@ class EditorSession {
   ~EditorSession();
 
   // Computes (or loads) the basis and builds the deformer, then announces the mesh. Throws
-  // InputError or SolverError, keeping the previous mesh, if that fails.
+  // InputError, SolverError or Cancelled, keeping the previous mesh, if that fails.
   void open(LoadedMesh mesh, std::string name);
 
   // Handles one message; errors are answered with an error message, never thrown.
   void handle(bool binary, std::string_view message);
 
-  // Abandons a running basis computation at its next progress report (from any thread).
-  void cancel() { cancelled_ = true; }
+  // open(), with a failure answered as a request's is (an error message, then "empty" when no
+  // mesh is open) and returned: the server's first mesh, opened while the page is served.
+  std::optional<std::string> start(LoadedMesh mesh, std::string name);
+
+  // Abandons a running basis computation at its next progress report (from any thread); the
+  // request that started it is answered with a "cancelled" error. Does nothing when none runs.
+  void cancel() {
+    if (computing_) cancelled_ = true;
+  }
 
  private:
   struct State;
+  struct Basis;
+  bool answer(const std::function<void()>& work);  // false: failed, answered with an error
   void dispatch(bool binary, std::string_view message);
   void text_message(std::string_view message);
-  void set_selection(Selection selection);
-  void solve_and_send();
+  void change_settings(std::string_view message);
+  void set_edit(GroupSelection edit, bool record);
+  void push_history();
+  void commit();  // an undo step if the transforms moved since the last one
+  void restore(size_t entry);
+  void apply_pose();
+  void open_scene(const NamedFile& file);
+  void solve_and_send(bool preview = false);
+  void send_mesh();
+  void send_ready();
+  void send_selection();
   void send_state();
-  void build(LoadedMesh mesh, std::string name, int modes, const DeformOptions& options,
-             std::shared_ptr<const ManifoldHarmonics> reuse_basis);
-  void send_error(const std::string& message);
+  void send_error(const std::string& message, bool cancelled = false);
+  Basis compute_basis(const TriangleMesh& mesh, int modes);
+  void build(LoadedMesh mesh, std::string name, int modes, const DeformOptions& options);
 
   EditorConfig config_;
   Send send_;
-  std::atomic<bool> cancelled_{false};
+  std::atomic<bool> computing_{false}, cancelled_{false};
+  std::string request_;     // the type of the message being handled
+  std::string last_error_;  // of the last request that failed
   std::unique_ptr<State> state_;
 };
 

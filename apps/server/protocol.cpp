@@ -33,6 +33,7 @@ class Reader {
   }
   size_t remaining() const { return data_.size() - pos_; }
   void align4() { bytes((4 - pos_ % 4) % 4); }
+  void align8() { bytes((8 - pos_ % 8) % 8); }
   void expect_end() const {
     if (remaining() != 0) fail(std::to_string(remaining()) + " bytes too many");
   }
@@ -57,6 +58,7 @@ class Writer {
   }
   void bytes(std::string_view b) { out_.append(b); }
   void align4() { out_.append((4 - out_.size() % 4) % 4, '\0'); }
+  void align8() { out_.append((8 - out_.size() % 8) % 8, '\0'); }
   std::string take() { return std::move(out_); }
   void reserve(size_t n) { out_.reserve(n); }
 
@@ -64,20 +66,43 @@ class Writer {
   std::string out_;
 };
 
+Eigen::Affine3d read_transform(Reader& r, const std::string& where) {
+  Eigen::Matrix4d m;
+  for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = r.get<double>();
+  return checked_transform(m, where);
+}
+
+void write_transform(Writer& w, const Eigen::Affine3d& t) {
+  for (int i = 0; i < 16; ++i) w.put(t.matrix()(i / 4, i % 4));
+}
+
 }  // namespace
 
 Tag message_tag(std::string_view message) {
   return static_cast<Tag>(Reader(message, "binary").get<uint32_t>());
 }
 
-Selection decode_selection(std::string_view message, int num_vertices) {
+GroupSelection decode_selection(std::string_view message, int num_vertices) {
   Reader r(message, "selection");
   r.get<uint32_t>();
   const uint32_t groups = r.get<uint32_t>(), fixed = r.get<uint32_t>();
+  r.get<uint32_t>();
   if (groups > kMaxGroups) r.fail(std::to_string(groups) + " handle groups (at most 64)");
   std::vector<uint32_t> sizes(groups);
   uint64_t total = fixed;
   for (uint32_t& s : sizes) total += s = r.get<uint32_t>();
+  GroupSelection out;
+  for (uint32_t g = 0; g < groups; ++g) {
+    const uint32_t flags = r.get<uint32_t>();
+    if (flags > 3) r.fail("group " + std::to_string(g) + " has unknown flags");
+    out.pinned.push_back((flags & 1) != 0);
+    out.fit.push_back((flags & 2) != 0);
+  }
+  r.align8();
+  for (uint32_t g = 0; g < groups; ++g) {
+    out.transforms.push_back(
+        read_transform(r, "selection message: transform " + std::to_string(g)));
+  }
   if (total * 4 != r.remaining()) r.fail("the sizes do not match the message's length");
   const auto read_list = [&](uint32_t count) {
     std::vector<int> list(count);
@@ -91,10 +116,9 @@ Selection decode_selection(std::string_view message, int num_vertices) {
     }
     return list;
   };
-  Selection s;
-  s.fixed = read_list(fixed);
-  for (uint32_t size : sizes) s.handles.push_back(read_list(size));
-  return s;
+  out.selection.fixed = read_list(fixed);
+  for (uint32_t size : sizes) out.selection.handles.push_back(read_list(size));
+  return out;
 }
 
 FrameRequest decode_frame(std::string_view message, int num_groups) {
@@ -103,16 +127,16 @@ FrameRequest decode_frame(std::string_view message, int num_groups) {
   FrameRequest f;
   f.seq = r.get<uint32_t>();
   const uint32_t groups = r.get<uint32_t>();
-  r.get<uint32_t>();
+  const uint32_t flags = r.get<uint32_t>();
+  if (flags > 1) r.fail("unknown flags");
+  f.preview = flags == 1;
   if (groups != static_cast<uint32_t>(num_groups)) {
     r.fail(std::to_string(groups) + " transforms for " + std::to_string(num_groups) +
            " handle groups");
   }
   if (r.remaining() != groups * 16 * sizeof(double)) r.fail("wrong length");
   for (uint32_t g = 0; g < groups; ++g) {
-    Eigen::Matrix4d m;
-    for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = r.get<double>();
-    f.transforms.push_back(checked_transform(m, "frame message: transform " + std::to_string(g)));
+    f.transforms.push_back(read_transform(r, "frame message: transform " + std::to_string(g)));
   }
   return f;
 }
@@ -132,12 +156,23 @@ NamedFile decode_file(std::string_view message) {
   return f;
 }
 
-std::string encode_selection(const Selection& selection, Tag tag) {
+std::string encode_selection(const GroupSelection& s, Tag tag) {
+  const Selection& selection = s.selection;
   Writer w;
   w.put(static_cast<uint32_t>(tag));
   w.put(static_cast<uint32_t>(selection.handles.size()));
   w.put(static_cast<uint32_t>(selection.fixed.size()));
+  w.put(uint32_t{0});
+  const size_t groups = selection.handles.size();
   for (const auto& g : selection.handles) w.put(static_cast<uint32_t>(g.size()));
+  for (size_t g = 0; g < groups; ++g) {
+    const bool pinned = g < s.pinned.size() && s.pinned[g], fit = g < s.fit.size() && s.fit[g];
+    w.put(static_cast<uint32_t>((pinned ? 1 : 0) | (fit ? 2 : 0)));
+  }
+  w.align8();
+  for (size_t g = 0; g < groups; ++g) {
+    write_transform(w, g < s.transforms.size() ? s.transforms[g] : Eigen::Affine3d::Identity());
+  }
   for (int v : selection.fixed) w.put(static_cast<uint32_t>(v));
   for (const auto& g : selection.handles) {
     for (int v : g) w.put(static_cast<uint32_t>(v));
@@ -150,10 +185,8 @@ std::string encode_frame(const FrameRequest& frame) {
   w.put(static_cast<uint32_t>(Tag::Frame));
   w.put(frame.seq);
   w.put(static_cast<uint32_t>(frame.transforms.size()));
-  w.put(uint32_t{0});
-  for (const Eigen::Affine3d& t : frame.transforms) {
-    for (int i = 0; i < 16; ++i) w.put(t.matrix()(i / 4, i % 4));
-  }
+  w.put(uint32_t{frame.preview ? 1u : 0u});
+  for (const Eigen::Affine3d& t : frame.transforms) write_transform(w, t);
   return w.take();
 }
 
@@ -182,21 +215,39 @@ std::string encode_mesh_message(const TriangleMesh& mesh) {
   return w.take();
 }
 
-std::string encode_frame_result(uint32_t seq, bool base_view, const FrameStats& stats,
-                                const Vertices& positions) {
+std::string encode_preview(const PreviewMesh& preview) {
   Writer w;
-  w.reserve(40 + 12 * positions.rows());
+  w.reserve(12 + 4 * preview.vertices.size() + 12 * preview.faces.rows());
+  w.put(static_cast<uint32_t>(Tag::Preview));
+  w.put(static_cast<uint32_t>(preview.vertices.size()));
+  w.put(static_cast<uint32_t>(preview.faces.rows()));
+  for (int v : preview.vertices) w.put(static_cast<uint32_t>(v));
+  for (Eigen::Index f = 0; f < preview.faces.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) w.put(static_cast<uint32_t>(preview.faces(f, k)));
+  }
+  return w.take();
+}
+
+std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& stats,
+                                const Vertices& positions, const PreviewMesh* preview) {
+  const bool subset = view.preview && preview != nullptr;
+  const size_t n = subset ? preview->vertices.size() : static_cast<size_t>(positions.rows());
+  Writer w;
+  w.reserve(48 + 12 * n);
   w.put(static_cast<uint32_t>(Tag::FrameResult));
   w.put(seq);
-  w.put(static_cast<uint32_t>(positions.rows()));
-  w.put(static_cast<uint32_t>(base_view ? 1 : 0));
+  w.put(static_cast<uint32_t>(n));
+  w.put(static_cast<uint32_t>((view.base ? 1 : 0) | (subset ? 2 : 0)));
   for (double ms : {stats.reduced_solve, stats.inverse_transform, stats.detail, stats.total}) {
     w.put(static_cast<float>(ms * 1e3));
   }
   w.put(static_cast<float>(stats.error_max));
   w.put(static_cast<float>(stats.error_rms));
-  for (Eigen::Index i = 0; i < positions.rows(); ++i) {
-    for (int k = 0; k < 3; ++k) w.put(static_cast<float>(positions(i, k)));
+  w.put(static_cast<uint32_t>(stats.arap_iterations));
+  w.put(uint32_t{stats.arap_converged ? 1u : 0u});
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Index v = subset ? preview->vertices[i] : static_cast<Eigen::Index>(i);
+    for (int k = 0; k < 3; ++k) w.put(static_cast<float>(positions(v, k)));
   }
   return w.take();
 }

@@ -6,20 +6,27 @@
 // element size, so the browser reads them with typed arrays in place.
 //
 // Browser -> server
-//   1 selection    u32 tag | u32 groups G | u32 fixed F | u32 size of each group (G) |
+//   1 selection    u32 tag | u32 groups G | u32 fixed F | u32 0 | u32 size of each group (G) |
+//                  u32 flags of each group (G; bit 0: pinned, bit 1: fit, see GroupSelection) |
+//                  f64 4 x 4 row-major transform of each group (16 G) |
 //                  u32 fixed vertices (F) | u32 vertices of group 0, 1, ... (mesh numbering)
-//   2 frame        u32 tag | u32 seq | u32 groups G | u32 0 | f64 4 x 4 row-major transform of
-//                  each group (16 G), acting on the mesh's rest positions
+//   2 frame        u32 tag | u32 seq | u32 groups G | u32 flags (bit 0: preview) |
+//                  f64 4 x 4 row-major transform of each group (16 G), acting on the rest shape
 //   3 mesh file    u32 tag | u32 name length L | name (L bytes, padded with zeros to 4) | file
 //   4 selection    the same layout as 3, for a .sel or .dmat file (file numbering)
+//   5 scene        the same layout as 3, for a scene (.json, docs/scene.md)
 // Server -> browser
 //   101 mesh       u32 tag | u32 n | u32 triangles T | f32 positions (3 n) | u32 corners (3 T)
-//   102 frame      u32 tag | u32 seq | u32 n | u32 view (0 detailed, 1 smooth base) |
+//   102 frame      u32 tag | u32 seq | u32 n | u32 view (bit 0: smooth base, bit 1: preview) |
 //                  f32 reduced solve, inverse transform, detail, total (ms) |
 //                  f32 constraint error max, rms (over the bounding-box diagonal) |
-//                  f32 positions (3 n)
+//                  u32 ARAP iterations | u32 1 if ARAP converged (or the energy is linear) |
+//                  f32 positions (3 n; a preview: of the preview's vertices, in its order)
 //   103 file       the layout of 3: an export for the browser to save
-//   104 selection  the layout of 1: a selection file read for the browser to adopt
+//   104 selection  the layout of 1 (no fit flags): the server's selection and transforms, for
+//                  the browser to adopt (after a reload, an undo, a selection file or a scene)
+//   105 preview    u32 tag | u32 k | u32 triangles T | u32 mesh vertex of each preview vertex
+//                  (k) | u32 corners (3 T, preview numbering): a coarse view for drags
 // Text (JSON objects with a "type"): see editor_session.h.
 #pragma once
 
@@ -40,19 +47,45 @@ enum class Tag : uint32_t {
   Frame = 2,
   MeshFile = 3,
   SelectionFile = 4,
+  SceneFile = 5,
   Mesh = 101,
   FrameResult = 102,
   File = 103,
   SelectionResult = 104,
+  Preview = 105,
 };
 
 // Limits that bound what a message can make the server allocate.
 inline constexpr uint32_t kMaxGroups = 64;
 inline constexpr uint32_t kMaxNameLength = 1024;
 
+// Handle groups with their transforms and flags. A pinned group holds its vertices where they
+// are shown: its transform is the one that best maps its rest positions to their current
+// positions, fitted by the server when `fit` is set (a new or repainted pin), and frames do not
+// move it.
+struct GroupSelection {
+  Selection selection;
+  std::vector<Eigen::Affine3d> transforms;  // one per group
+  std::vector<bool> pinned, fit;            // one per group
+};
+
 struct FrameRequest {
   uint32_t seq = 0;
   std::vector<Eigen::Affine3d> transforms;  // one per handle group
+  bool preview = false;                     // answer with the preview's vertices only
+};
+
+// A coarse version of the mesh drawn during drags: some of its vertices and triangles between
+// them (preview.h).
+struct PreviewMesh {
+  std::vector<int> vertices;  // mesh vertex of each preview vertex
+  Faces faces;                // preview numbering
+};
+
+// What a frame result shows.
+struct FrameView {
+  bool base = false;     // the deformed smooth base instead of the detailed result
+  bool preview = false;  // only the preview's vertices
 };
 
 struct NamedFile {
@@ -63,24 +96,29 @@ struct NamedFile {
 struct FrameStats {
   double reduced_solve = 0, inverse_transform = 0, detail = 0, total = 0;  // seconds
   double error_max = 0, error_rms = 0;
+  int arap_iterations = 0;
+  bool arap_converged = true;
 };
 
 // The tag of a binary message; throws InputError for one shorter than a tag.
 Tag message_tag(std::string_view message);
 
-// Throws InputError for a wrong length, too many groups, or an index out of [0, n).
-Selection decode_selection(std::string_view message, int num_vertices);
+// Throws InputError for a wrong length, too many groups, unknown flags, a transform
+// checked_transform() refuses, or an index out of [0, n).
+GroupSelection decode_selection(std::string_view message, int num_vertices);
 // Throws InputError for a wrong length, a group count other than `num_groups`, or a transform
 // checked_transform() (scene.h) refuses.
 FrameRequest decode_frame(std::string_view message, int num_groups);
 // Throws InputError for a wrong length or a name that is empty, too long or not printable.
 NamedFile decode_file(std::string_view message);
 
-std::string encode_selection(const Selection& selection, Tag tag = Tag::SelectionResult);
+std::string encode_selection(const GroupSelection& selection, Tag tag = Tag::SelectionResult);
 std::string encode_frame(const FrameRequest& frame);
 std::string encode_file(const NamedFile& file, Tag tag = Tag::File);
 std::string encode_mesh_message(const TriangleMesh& mesh);
-std::string encode_frame_result(uint32_t seq, bool base_view, const FrameStats& stats,
-                                const Vertices& positions);
+std::string encode_preview(const PreviewMesh& preview);
+// `positions`: the whole mesh's; a preview view sends those of `preview`'s vertices.
+std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& stats,
+                                const Vertices& positions, const PreviewMesh* preview = nullptr);
 
 }  // namespace specdeform::server

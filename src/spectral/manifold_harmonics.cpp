@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iomanip>
 #include <limits>
 #include <numbers>
@@ -290,8 +291,12 @@ void multiply_in_place(Matrix& V, Eigen::Index k, const Mat& Z) {
 //     A V = V T + Q F^T,    V^T M V = I,  Q^T M Q = I,  V^T M Q = 0,
 // so Ritz pairs (theta, y = V z) of T have the residual A y - theta y = Q F^T z for free, and
 // A y / theta = y + Q F^T z / theta is one step of inverse iteration, also for free.
+// `progress(fraction)` is called before every block step with the fraction of the work done,
+// estimated from the steps taken and the pairs each restart converged (the first pass is
+// taken for half of the work until the first restart tells).
 BandResult solve_band(ShiftInvert& op, const MassOperator& M, const Basis& found, const Basis& near,
-                      const BandSettings& set, std::mt19937_64& rng) {
+                      const BandSettings& set, std::mt19937_64& rng,
+                      const std::function<void(double)>& progress) {
   const int n = static_cast<int>(M.matrix().rows());
   const int b = set.block, s = set.subspace;
   const int width = (b + 7) / 8 * 8;  // basis_sweep's blocks: a multiple of 8 columns
@@ -307,8 +312,12 @@ BandResult solve_band(ShiftInvert& op, const MassOperator& M, const Basis& found
   // permutation then moves whole rows.
   RowMatrix X = RowMatrix::Zero(n, width), D1, D2, gram, MQ, solved;
   Mat W;
+  int steps = 0, last_converged = 0;
+  double estimate = 2.0 * (s / b), done = 0.0;  // total block steps, fraction reported
   for (;;) {
     while (k + b <= s) {
+      done = std::max(done, std::min(0.99, steps++ / estimate));
+      progress(done);
       V.middleCols(k, b) = Q;
       M.apply(Q, MQ);
       op.solve(MQ, solved);
@@ -372,6 +381,11 @@ BandResult solve_band(ShiftInvert& op, const MassOperator& M, const Basis& found
         break;
       ++converged;
     }
+    const int gained = converged - last_converged;
+    last_converged = converged;
+    const double restarts_left =
+        gained > 0 ? double(set.wanted - converged) / gained : set.max_restarts - out.restarts;
+    estimate = steps + std::max(0.0, restarts_left) * ((s - keep) / b);
     if (converged >= set.wanted || out.restarts >= set.max_restarts) {
       out.converged = converged >= set.wanted;
       const int count = std::max(converged, std::min(set.wanted, keep));
@@ -640,8 +654,10 @@ Spectrum solve_block_krylov(const Sparse& K, const Sparse& Mmat, int m,
         count > 0 ? out.lambda[count - 1] : -std::numeric_limits<double>::infinity();
     int near = count;
     while (near > 0 && out.lambda[near - 1] >= sigma - 1.2 * set.wanted * spacing) --near;
-    BandResult r =
-        solve_band(op, M, out.H.leftCols(count), out.H.middleCols(near, count - near), set, rng);
+    const int band_pairs = std::min(set.wanted, m - count);
+    BandResult r = solve_band(
+        op, M, out.H.leftCols(count), out.H.middleCols(near, count - near), set, rng,
+        [&](double fraction) { report(o, (count + fraction * band_pairs) / m, "eigenvectors"); });
     out.restarts += r.restarts;
     out.solves += r.solves;
     rayleigh_ritz(K, M, r.H, r.lambda);

@@ -119,8 +119,9 @@ TEST_F(EditorServerTest, AnswersMessagesAndSurvivesBadOnes) {
   ws->write(net::buffer(std::string("\x02\0\0", 3)));
   EXPECT_NE(read_until(*ws, "error")["message"].get<std::string>().find("truncated"),
             std::string::npos);
-  ws->write(net::buffer(encode_selection({{{0, 1}}, {100}}, Tag::Selection)));
-  EXPECT_EQ(read_until(*ws, "selection")["handles"][0], 2);
+  ws->write(net::buffer(encode_selection(
+      {{{{0, 1}}, {100}}, {Eigen::Affine3d::Identity()}, {false}, {false}}, Tag::Selection)));
+  EXPECT_EQ(read_until(*ws, "state")["groups"][0]["vertices"], 2);
 }
 
 TEST_F(EditorServerTest, ClosesAConnectionThatSendsTooMuch) {

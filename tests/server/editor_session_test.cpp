@@ -2,10 +2,14 @@
 
 #include <cstring>
 #include <fstream>
+#include <numeric>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "pose.h"
+#include "preview.h"
 #include "protocol.h"
 #include "specdeform/deform/scene.h"
 #include "specdeform/mesh/generate.h"
@@ -19,6 +23,25 @@ struct Sent {
   bool binary;
   std::string data;
 };
+
+GroupSelection plain(Selection s) {
+  const size_t g = s.handles.size();
+  return {std::move(s), std::vector<Eigen::Affine3d>(g, Eigen::Affine3d::Identity()),
+          std::vector<bool>(g, false), std::vector<bool>(g, false)};
+}
+
+// Positions of a frame result message.
+Vertices frame_positions(const std::string& m) {
+  uint32_t n = 0;
+  std::memcpy(&n, m.data() + 8, 4);
+  Vertices V(n, 3);
+  for (uint32_t i = 0; i < 3 * n; ++i) {
+    float x = 0;
+    std::memcpy(&x, m.data() + 48 + 4 * i, 4);
+    V(i / 3, i % 3) = x;
+  }
+  return V;
+}
 
 // An editor session on a small sphere with everything it sends recorded.
 class EditorSessionTest : public ::testing::Test {
@@ -39,33 +62,40 @@ class EditorSessionTest : public ::testing::Test {
     }
   }
 
-  std::vector<Sent> take() { return std::exchange(sent_, {}); }
-
-  Json last_text() {
+  Json last_text(const std::string& type = "") {
     for (auto it = sent_.rbegin(); it != sent_.rend(); ++it) {
-      if (!it->binary) return Json::parse(it->data);
+      if (it->binary) continue;
+      Json j = Json::parse(it->data);
+      if (type.empty() || j["type"] == type) return j;
     }
     return {};
   }
 
-  // Positions of the last frame result.
-  Vertices last_frame() {
-    for (auto it = sent_.rbegin(); it != sent_.rend(); ++it) {
-      if (!it->binary || message_tag(it->data) != Tag::FrameResult) continue;
-      uint32_t n = 0;
-      std::memcpy(&n, it->data.data() + 8, 4);
-      Vertices V(n, 3);
-      for (uint32_t i = 0; i < 3 * n; ++i) {
-        float x = 0;
-        std::memcpy(&x, it->data.data() + 40 + 4 * i, 4);
-        V(i / 3, i % 3) = x;
-      }
-      return V;
+  // The text message types sent since the last clear, in order.
+  std::vector<std::string> text_types() {
+    std::vector<std::string> out;
+    for (const Sent& s : sent_) {
+      if (!s.binary) out.push_back(Json::parse(s.data)["type"]);
     }
-    return {};
+    return out;
+  }
+
+  const std::string* last_binary(Tag tag) {
+    for (auto it = sent_.rbegin(); it != sent_.rend(); ++it) {
+      if (it->binary && message_tag(it->data) == tag) return &it->data;
+    }
+    return nullptr;
+  }
+
+  Vertices last_frame() {
+    const std::string* m = last_binary(Tag::FrameResult);
+    return m ? frame_positions(*m) : Vertices();
   }
 
   std::string frame(const Eigen::Affine3d& t, uint32_t seq = 1) { return encode_frame({seq, {t}}); }
+  void select(const GroupSelection& s) {
+    session_->handle(true, encode_selection(s, Tag::Selection));
+  }
 
   std::unique_ptr<EditorSession> session_;
   std::vector<Sent> sent_;
@@ -74,18 +104,19 @@ class EditorSessionTest : public ::testing::Test {
 };
 
 TEST_F(EditorSessionTest, OpenAnnouncesTheMeshAndItsBasis) {
-  ASSERT_EQ(sent_.size() >= 2, true);
-  EXPECT_EQ(message_tag(sent_[sent_.size() - 2].data), Tag::Mesh);
-  const Json ready = last_text();
-  EXPECT_EQ(ready["type"], "ready");
+  ASSERT_TRUE(last_binary(Tag::Mesh));
+  const Json ready = last_text("ready");
   EXPECT_EQ(ready["vertices"], rest_.rows());
   EXPECT_EQ(ready["modes"], 30);
   EXPECT_EQ(ready["settings"]["detail"], "transfer");
+  EXPECT_EQ(ready["settings"]["energy"], "linear");
+  EXPECT_EQ(ready["mesh_id"].get<std::string>().size(), 16u);
+  EXPECT_EQ(last_text()["type"], "state");
 }
 
 TEST_F(EditorSessionTest, FramesMeetTheHandleTargets) {
-  session_->handle(true, encode_selection(selection_, Tag::Selection));
-  EXPECT_EQ(last_text()["type"], "selection");
+  select(plain(selection_));
+  EXPECT_EQ(last_text()["type"], "state");
   const Eigen::Vector3d t(0.1, -0.2, 0.3);
   session_->handle(true, frame(Eigen::Affine3d(Eigen::Translation3d(t))));
   const Vertices V = last_frame();
@@ -101,46 +132,74 @@ TEST_F(EditorSessionTest, FramesMeetTheHandleTargets) {
 }
 
 TEST_F(EditorSessionTest, BadMessagesAreAnsweredAndChangeNothing) {
-  session_->handle(true, encode_selection(selection_, Tag::Selection));
+  select(plain(selection_));
   const Eigen::Affine3d lift(Eigen::Translation3d(0, 0, 0.2));
   session_->handle(true, frame(lift));
   const Vertices before = last_frame();
   Eigen::Affine3d nan = lift;
   nan(0, 0) = std::nan("");
-  const std::vector<std::pair<bool, std::string>> bad = {
-      {true, encode_frame({3, {lift, lift}})},                       // two groups, one selected
-      {true, frame(nan, 3)},                                         // not finite
-      {true, encode_selection({{{9999}}, {}}, Tag::Selection)},      // out of range
-      {true, encode_selection({{{0}, {0}}, {}}, Tag::Selection)},    // one vertex in two groups
-      {true, std::string("\x07\0\0\0", 4)},                          // unknown tag
-      {true, std::string("\x02\0", 2)},                              // truncated
-      {true, encode_file({"x.xyz", "1 2 3"}, Tag::MeshFile)},        // unknown format
-      {true, encode_file({"x.sel", "2\n2\n"}, Tag::SelectionFile)},  // wrong vertex count
-      {false, "not json"},
-      {false, R"({"type": "launch"})"},
-      {false, R"({"type": "settings", "modes": -3})"},
-      {false, R"({"type": "settings", "detail": "sparkles"})"},
-      {false, R"({"type": "settings", "ks": 0, "kb": 0})"},
-      {false, R"({"type": "export_mesh", "format": "docx"})"},
+  const std::vector<std::tuple<bool, std::string, std::string>> bad = {
+      {true, encode_frame({3, {lift, lift}}), "frame"},  // two groups, one selected
+      {true, frame(nan, 3), "frame"},                    // not finite
+      {true, encode_selection(plain({{{9999}}, {}}), Tag::Selection), "selection"},
+      {true, encode_selection(plain({{{0}, {0}}, {}}), Tag::Selection), "selection"},
+      {true, std::string("\x07\0\0\0", 4), "binary"},  // unknown tag
+      {true, std::string("\x02\0", 2), "binary"},      // truncated
+      {true, encode_file({"x.xyz", "1 2 3"}, Tag::MeshFile), "mesh_file"},
+      {true, encode_file({"x.sel", "2\n2\n"}, Tag::SelectionFile), "selection_file"},
+      {true,
+       encode_file({"x.json", R"({"handles": [{"selection": "/etc/passwd"}]})"}, Tag::SceneFile),
+       "scene_file"},
+      {false, "not json", "text"},
+      {false, R"({"type": "launch"})", "launch"},
+      {false, R"({"type": "export_mesh", "format": "docx"})", "export_mesh"},
+      {false, R"({"type": "preview"})", "preview"},
+      {false, R"({"type": "redo"})", "redo"},
   };
-  for (const auto& [binary, message] : bad) {
+  for (const auto& [binary, message, request] : bad) {
     sent_.clear();
     session_->handle(binary, message);
-    ASSERT_EQ(sent_.size(), 1u);
+    ASSERT_EQ(sent_.size(), 1u) << message;
     const Json reply = Json::parse(sent_[0].data);
     EXPECT_EQ(reply["type"], "error");
+    EXPECT_EQ(reply["request"], request);
     EXPECT_EQ(reply["message"].get<std::string>().find('\n'), std::string::npos);
   }
   session_->handle(true, frame(lift, 4));
   EXPECT_LT((last_frame() - before).cwiseAbs().maxCoeff(), 1e-7);
 }
 
+// A rejected setting is answered with the error and the settings in force; the next valid
+// one, and one that changes nothing, are answered with "ready" (the page never waits forever).
+TEST_F(EditorSessionTest, EverySettingsRequestEndsInReady) {
+  for (const std::string bad :
+       {R"({"type": "settings", "kb": 0})", R"({"type": "settings", "modes": -3})",
+        R"({"type": "settings", "detail": "sparkles"})",
+        R"({"type": "settings", "energy": "elastic"})"}) {
+    sent_.clear();
+    session_->handle(false, bad);
+    EXPECT_EQ(text_types(), (std::vector<std::string>{"error", "ready"})) << bad;
+    EXPECT_EQ(last_text("error")["request"], "settings");
+    EXPECT_EQ(last_text("ready")["settings"]["kb"], 1.0);
+    EXPECT_EQ(last_text("ready")["modes"], 30);
+  }
+  for (const std::string good :
+       {R"({"type": "settings", "kb": 1})", R"({"type": "settings", "kb": 2})",
+        R"({"type": "settings", "constraints": "hard"})",
+        R"({"type": "settings", "constraints": "soft"})"}) {
+    sent_.clear();
+    session_->handle(false, good);
+    EXPECT_EQ(text_types(), std::vector<std::string>{"ready"}) << good;
+  }
+  EXPECT_EQ(last_text("ready")["settings"]["kb"], 2.0);
+}
+
 TEST_F(EditorSessionTest, SettingsRebuildAndKeepTheSelection) {
-  session_->handle(true, encode_selection(selection_, Tag::Selection));
+  select(plain(selection_));
   const Eigen::Vector3d t(0, 0, 0.25);
   session_->handle(true, frame(Eigen::Affine3d(Eigen::Translation3d(t))));
   session_->handle(false, R"({"type": "settings", "detail": "displacement", "modes": 20})");
-  const Json ready = last_text();
+  const Json ready = last_text("ready");
   EXPECT_EQ(ready["settings"]["detail"], "displacement");
   EXPECT_EQ(ready["modes"], 20);
   const Vertices V = last_frame();  // the frame is solved again with the new settings
@@ -151,8 +210,137 @@ TEST_F(EditorSessionTest, SettingsRebuildAndKeepTheSelection) {
   EXPECT_NE(last_frame(), V);
 }
 
-TEST_F(EditorSessionTest, ExportsTheDeformedMeshAndTheScene) {
-  session_->handle(true, encode_selection(selection_, Tag::Selection));
+TEST_F(EditorSessionTest, ArapIsAnEnergyOfThePanel) {
+  select(plain(selection_));
+  const Eigen::Affine3d turn(Eigen::AngleAxisd(0.8, Eigen::Vector3d::UnitX()));
+  session_->handle(true, frame(turn));
+  const Vertices linear = last_frame();
+  session_->handle(false, R"({"type": "settings", "energy": "arap"})");
+  EXPECT_EQ(last_text("ready")["settings"]["energy"], "arap");
+  EXPECT_GT(last_text("ready")["arap_clusters"], 0);
+  const std::string& m = *last_binary(Tag::FrameResult);
+  uint32_t iterations = 0;
+  std::memcpy(&iterations, m.data() + 40, 4);
+  EXPECT_GT(iterations, 0u);
+  EXPECT_GT((frame_positions(m) - linear).cwiseAbs().maxCoeff(), 1e-3);
+}
+
+// A new connection ("hello") gets the whole edit back: mesh, settings, groups with their
+// transforms and flags, undo, and the deformed frame.
+TEST_F(EditorSessionTest, HelloRestoresTheEdit) {
+  session_->handle(false, R"({"type": "settings", "kb": 3})");
+  GroupSelection s = plain(selection_);
+  s.transforms[0] = Eigen::Translation3d(0, 0.1, 0);
+  select(s);
+  sent_.clear();
+  session_->handle(false, R"({"type": "hello"})");
+  EXPECT_EQ(text_types(), (std::vector<std::string>{"ready", "state"}));
+  EXPECT_EQ(last_text("ready")["settings"]["kb"], 3.0);
+  const GroupSelection back =
+      decode_selection(*last_binary(Tag::SelectionResult), static_cast<int>(rest_.rows()));
+  EXPECT_EQ(back.selection.handles, selection_.handles);
+  EXPECT_EQ(back.selection.fixed, selection_.fixed);
+  EXPECT_TRUE(back.transforms[0].matrix().isApprox(s.transforms[0].matrix()));
+  EXPECT_TRUE(last_text("state")["undo"]);
+  for (int i : selection_.handles[0]) EXPECT_NEAR(last_frame()(i, 1), rest_(i, 1) + 0.1, 1e-5);
+}
+
+TEST_F(EditorSessionTest, UndoAndRedoWalkTheEdits) {
+  select(plain(selection_));
+  const Eigen::Affine3d up(Eigen::Translation3d(0, 0, 0.2));
+  session_->handle(true, frame(up));
+  session_->handle(false, R"({"type": "commit"})");
+  EXPECT_TRUE(last_text("state")["undo"]);
+  EXPECT_FALSE(last_text("state")["redo"]);
+  const Vertices moved = last_frame();
+
+  session_->handle(false, R"({"type": "undo"})");  // the transform back to the identity
+  EXPECT_LT((last_frame() - rest_).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_TRUE(last_text("state")["redo"]);
+  session_->handle(false, R"({"type": "undo"})");  // no selection
+  EXPECT_EQ(decode_selection(*last_binary(Tag::SelectionResult), 162).selection.handles.size(), 0u);
+  EXPECT_FALSE(last_text("state")["undo"]);
+  session_->handle(false, R"({"type": "redo"})");
+  session_->handle(false, R"({"type": "redo"})");
+  EXPECT_LT((last_frame() - moved).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+// A pinned group stays where it was shown when it was painted, whatever the handle does next.
+TEST_F(EditorSessionTest, PinsHoldTheShownPosition) {
+  select(plain(selection_));
+  session_->handle(true, frame(Eigen::Affine3d(Eigen::Translation3d(0.3, 0, 0))));
+  const Vertices shown = last_frame();
+  std::vector<int> belt;  // around the equator, moved by the drag
+  for (int i = 0; i < rest_.rows(); ++i) {
+    if (std::abs(rest_(i, 2)) < 0.15 && rest_(i, 0) > 0.5) belt.push_back(i);
+  }
+  ASSERT_GT((shown(belt[0], 0) - rest_(belt[0], 0)), 0.01);
+  GroupSelection s = plain(selection_);
+  s.selection.handles.push_back(belt);
+  s.transforms = {Eigen::Affine3d(Eigen::Translation3d(0.3, 0, 0)), Eigen::Affine3d::Identity()};
+  s.pinned = {false, true};
+  s.fit = {false, true};
+  select(s);
+  const Json state = last_text("state");
+  EXPECT_TRUE(state["groups"][1]["pinned"]);
+  EXPECT_LT(state["pin_error"].get<double>(), 0.01);
+  // The handle moves on; the pin neither follows the frame's transform for it nor springs back.
+  session_->handle(
+      true,
+      encode_frame(
+          {5, {Eigen::Affine3d(Eigen::Translation3d(0.3, 0.3, 0)), Eigen::Affine3d::Identity()}}));
+  const Vertices V = last_frame();
+  for (int i : belt) EXPECT_LT((V.row(i) - shown.row(i)).norm(), 0.02) << i;
+}
+
+// "apply_pose": the shown result becomes the rest shape; pins become fixed vertices there, and
+// handles start again from the identity.
+TEST_F(EditorSessionTest, ApplyPoseMakesTheResultTheRestShape) {
+  select(plain(selection_));
+  session_->handle(true, frame(Eigen::Affine3d(Eigen::Translation3d(0.2, 0, 0))));
+  const Vertices posed = last_frame();
+  sent_.clear();
+  session_->handle(false, R"({"type": "apply_pose"})");
+  ASSERT_TRUE(last_binary(Tag::Mesh));
+  uint32_t n = 0;
+  std::memcpy(&n, last_binary(Tag::Mesh)->data() + 4, 4);
+  float x = 0;
+  std::memcpy(&x, last_binary(Tag::Mesh)->data() + 12 + 12 * selection_.handles[0][0], 4);
+  EXPECT_NEAR(x, posed(selection_.handles[0][0], 0), 1e-6);
+  const Json ready = last_text("ready");
+  EXPECT_EQ(ready["pose"], 1);
+  EXPECT_NE(ready["basis"]["source"], "cache");
+  EXPECT_TRUE(last_text("state")["undo"]);
+  // From the new rest shape, the identity keeps the pose.
+  EXPECT_LT((last_frame() - posed).cwiseAbs().maxCoeff(), 1e-5);
+  // Undo returns to the first pose and its deformed frame.
+  session_->handle(false, R"({"type": "undo"})");
+  EXPECT_EQ(last_text("ready")["pose"], 0);
+  EXPECT_LT((last_frame() - posed).cwiseAbs().maxCoeff(), 1e-5);
+}
+
+TEST_F(EditorSessionTest, PreviewFramesCarryThePreviewVertices) {
+  select(plain(selection_));
+  session_->handle(false, R"({"type": "preview", "vertices": 60})");
+  const std::string* preview = last_binary(Tag::Preview);
+  ASSERT_TRUE(preview);
+  uint32_t k = 0;
+  std::memcpy(&k, preview->data() + 4, 4);
+  EXPECT_GE(k, 45u);
+  EXPECT_LE(k, 75u);
+  std::vector<uint32_t> vertices(k);
+  std::memcpy(vertices.data(), preview->data() + 12, 4 * k);
+  const Eigen::Affine3d up(Eigen::Translation3d(0, 0, 0.2));
+  session_->handle(true, encode_frame({7, {up}, true}));
+  const Vertices coarse = last_frame();
+  ASSERT_EQ(coarse.rows(), k);
+  session_->handle(true, encode_frame({8, {up}, false}));
+  const Vertices full = last_frame();
+  for (uint32_t i = 0; i < k; ++i) EXPECT_EQ(coarse.row(i), full.row(vertices[i]));
+}
+
+TEST_F(EditorSessionTest, ExportsTheDeformedMeshAndTheSceneAndOpensItAgain) {
+  select(plain(selection_));
   const Eigen::Affine3d t(Eigen::Translation3d(0.05, 0, 0.2));
   session_->handle(true, frame(t));
   session_->handle(false, R"({"type": "export_mesh", "format": "obj"})");
@@ -175,16 +363,103 @@ TEST_F(EditorSessionTest, ExportsTheDeformedMeshAndTheScene) {
   ASSERT_EQ(scene.transforms.size(), 1u);
   EXPECT_TRUE(scene.transforms[0].matrix().isApprox(t.matrix(), 1e-12));
   EXPECT_EQ(scene.modes, 30);
+
+  // "Open scene" of what "Export scene" wrote: the same selection and transform, after a clear.
+  const Vertices deformed = last_frame();
+  select(plain({}));
+  session_->handle(true, encode_file(scene_file, Tag::SceneFile));
+  const GroupSelection back =
+      decode_selection(*last_binary(Tag::SelectionResult), static_cast<int>(rest_.rows()));
+  EXPECT_EQ(back.selection.handles, selection_.handles);
+  EXPECT_EQ(back.selection.fixed, selection_.fixed);
+  EXPECT_LT((last_frame() - deformed).cwiseAbs().maxCoeff(), 1e-6);
 }
 
-TEST_F(EditorSessionTest, SelectionFilesComeBackInMeshNumbering) {
+TEST_F(EditorSessionTest, SelectionFilesAreAdopted) {
   std::string sel;
   for (int i = 0; i < rest_.rows(); ++i) sel += i == 3 ? "2\n" : i == 5 ? "0\n" : "1\n";
   session_->handle(true, encode_file({"pick.sel", sel}, Tag::SelectionFile));
-  ASSERT_TRUE(sent_.back().binary);
-  const Selection s = decode_selection(sent_.back().data, static_cast<int>(rest_.rows()));
-  EXPECT_EQ(s.handles, std::vector<std::vector<int>>{{3}});
-  EXPECT_EQ(s.fixed, std::vector<int>{5});
+  const GroupSelection s =
+      decode_selection(*last_binary(Tag::SelectionResult), static_cast<int>(rest_.rows()));
+  EXPECT_EQ(s.selection.handles, std::vector<std::vector<int>>{{3}});
+  EXPECT_EQ(s.selection.fixed, std::vector<int>{5});
+  EXPECT_TRUE(last_text("state")["undo"]);
+}
+
+// Cancel during a basis computation: the request is answered with a "cancelled" error and the
+// session keeps its mesh and settings.
+TEST(EditorSessionCancel, CancelKeepsThePreviousState) {
+  std::vector<Json> texts;
+  EditorSession* self = nullptr;
+  bool armed = false;
+  EditorSession session(EditorConfig{.modes = 20}, [&](bool binary, std::string data) {
+    if (binary) return;
+    texts.push_back(Json::parse(data));
+    if (armed && texts.back()["type"] == "progress" && texts.back()["fraction"] < 1.0) {
+      self->cancel();
+    }
+  });
+  self = &session;
+  LoadedMesh mesh;
+  mesh.mesh = make_icosphere(4);
+  mesh.info = identity_read_info(mesh.mesh);
+  session.open(std::move(mesh), "sphere.obj");
+  texts.clear();
+  armed = true;
+  session.handle(false, R"({"type": "settings", "modes": 60})");
+  ASSERT_GE(texts.size(), 3u);
+  EXPECT_EQ(texts[0]["type"], "progress");
+  EXPECT_TRUE(texts[0]["cancellable"]);
+  const Json& error = texts[texts.size() - 2];
+  EXPECT_EQ(error["type"], "error");
+  EXPECT_TRUE(error["cancelled"]);
+  EXPECT_EQ(texts.back()["type"], "ready");
+  EXPECT_EQ(texts.back()["modes"], 20);
+}
+
+TEST(Preview, CoarsensToAboutTheTargetAndKeepsMeshVertices) {
+  const TriangleMesh mesh = make_icosphere(5);  // 10242 vertices
+  const PreviewMesh p = make_preview(mesh, 1000);
+  EXPECT_GE(p.vertices.size(), 750u);
+  EXPECT_LE(p.vertices.size(), 1250u);
+  EXPECT_GT(p.faces.rows(), static_cast<Eigen::Index>(p.vertices.size()));  // a surface, ~2k
+  EXPECT_GE(p.faces.minCoeff(), 0);
+  EXPECT_LT(p.faces.maxCoeff(), static_cast<int>(p.vertices.size()));
+  for (int v : p.vertices) ASSERT_TRUE(v >= 0 && v < mesh.num_vertices());
+  EXPECT_EQ(make_preview(mesh, 20000).vertices.size(), 10242u);
+  EXPECT_THROW(make_preview(mesh, 2), InputError);
+}
+
+TEST(Pose, FitTransformRecoversAMotionAndStaysInvertibleOnFlatRegions) {
+  const TriangleMesh mesh = make_icosphere(2);
+  const Eigen::Affine3d motion = Eigen::Translation3d(0.1, -0.4, 2) *
+                                 Eigen::AngleAxisd(1.1, Eigen::Vector3d(1, 2, 0.5).normalized());
+  const Vertices moved =
+      (mesh.V * motion.linear().transpose()).rowwise() + motion.translation().transpose();
+  std::vector<int> all(mesh.num_vertices());
+  std::iota(all.begin(), all.end(), 0);
+  const FittedTransform fit = fit_transform(mesh.V, moved, all);
+  EXPECT_LT(fit.max_error, 1e-9);
+  EXPECT_TRUE(fit.transform.matrix().isApprox(motion.matrix(), 1e-9));
+  // Three vertices span a plane only: the fit is still invertible and exact on them.
+  const FittedTransform flat = fit_transform(mesh.V, moved, {0, 1, 2});
+  EXPECT_LT(flat.max_error, 1e-6);
+  EXPECT_GT(std::abs(flat.transform.linear().determinant()), 0.1);
+  EXPECT_THROW(fit_transform(mesh.V, moved, {}), InputError);
+}
+
+TEST(Pose, AReusedBasisIsExactForARigidMotion) {
+  const TriangleMesh mesh = make_icosphere(3);
+  const ManifoldHarmonics basis = compute_manifold_harmonics(mesh, {.num_modes = 20});
+  TriangleMesh turned = mesh;
+  turned.V = mesh.V * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const ManifoldHarmonics reused = reuse_basis(turned, basis);
+  EXPECT_LT(reused.max_residual, 1e-8);
+  EXPECT_LT((reused.eigenvalues - basis.eigenvalues).cwiseAbs().maxCoeff(),
+            1e-6 * basis.eigenvalues.maxCoeff());
+  TriangleMesh stretched = mesh;
+  stretched.V.col(0) *= 3.0;
+  EXPECT_GT(reuse_basis(stretched, basis).max_residual, kReuseResidual);
 }
 
 }  // namespace

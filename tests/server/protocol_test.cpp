@@ -10,27 +10,47 @@
 namespace specdeform::server {
 namespace {
 
+GroupSelection groups(Selection s) {
+  const size_t g = s.handles.size();
+  return {std::move(s), std::vector<Eigen::Affine3d>(g, Eigen::Affine3d::Identity()),
+          std::vector<bool>(g, false), std::vector<bool>(g, false)};
+}
+
 TEST(Protocol, SelectionRoundTrips) {
-  const Selection s{{{3, 1}, {}, {7}}, {0, 5}};
-  const Selection back = decode_selection(encode_selection(s, Tag::Selection), 8);
-  EXPECT_EQ(back.handles, s.handles);
-  EXPECT_EQ(back.fixed, s.fixed);
+  GroupSelection s = groups({{{3, 1}, {}, {7}}, {0, 5}});
+  s.transforms[1] =
+      Eigen::Translation3d(1, 2, 3) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX());
+  s.pinned[2] = true;
+  s.fit[2] = true;
+  const GroupSelection back = decode_selection(encode_selection(s, Tag::Selection), 8);
+  EXPECT_EQ(back.selection.handles, s.selection.handles);
+  EXPECT_EQ(back.selection.fixed, s.selection.fixed);
+  EXPECT_EQ(back.pinned, s.pinned);
+  EXPECT_EQ(back.fit, s.fit);
+  EXPECT_TRUE(back.transforms[1].matrix().isApprox(s.transforms[1].matrix(), 0));
 }
 
 TEST(Protocol, SelectionRejectsBadMessages) {
-  const std::string good = encode_selection({{{3, 1}}, {0}}, Tag::Selection);
+  const std::string good = encode_selection(groups({{{3, 1}}, {0}}), Tag::Selection);
   EXPECT_THROW(decode_selection(good, 3), InputError);  // vertex 3 of a 3-vertex mesh
   EXPECT_THROW(decode_selection(good.substr(0, good.size() - 4), 8), InputError);
   EXPECT_THROW(decode_selection(good + std::string(4, '\0'), 8), InputError);
   EXPECT_THROW(decode_selection(good.substr(0, 6), 8), InputError);
   Selection many;
   many.handles.resize(kMaxGroups + 1);
-  EXPECT_THROW(decode_selection(encode_selection(many, Tag::Selection), 8), InputError);
+  EXPECT_THROW(decode_selection(encode_selection(groups(many), Tag::Selection), 8), InputError);
   // A group size that would overflow 32 bits when multiplied by 4.
-  std::string huge = encode_selection({{{}}, {}}, Tag::Selection);
+  std::string huge = encode_selection(groups({{{}}, {}}), Tag::Selection);
   const uint32_t big = 0x40000001;
-  huge.replace(12, 4, reinterpret_cast<const char*>(&big), 4);
+  huge.replace(16, 4, reinterpret_cast<const char*>(&big), 4);
   EXPECT_THROW(decode_selection(huge, 8), InputError);
+  std::string flags = good;  // unknown group flags
+  const uint32_t four = 4;
+  flags.replace(20, 4, reinterpret_cast<const char*>(&four), 4);
+  EXPECT_THROW(decode_selection(flags, 8), InputError);
+  GroupSelection singular = groups({{{1}}, {}});
+  singular.transforms[0].linear().setZero();
+  EXPECT_THROW(decode_selection(encode_selection(singular, Tag::Selection), 8), InputError);
 }
 
 TEST(Protocol, FrameRoundTripsAndValidates) {
@@ -39,6 +59,8 @@ TEST(Protocol, FrameRoundTripsAndValidates) {
   const FrameRequest f{42, {t, Eigen::Affine3d::Identity()}};
   const FrameRequest back = decode_frame(encode_frame(f), 2);
   EXPECT_EQ(back.seq, 42u);
+  EXPECT_FALSE(back.preview);
+  EXPECT_TRUE(decode_frame(encode_frame({1, {t, t}, true}), 2).preview);
   ASSERT_EQ(back.transforms.size(), 2u);
   EXPECT_TRUE(back.transforms[0].matrix().isApprox(t.matrix(), 0));
   EXPECT_THROW(decode_frame(encode_frame(f), 1), InputError);  // group count mismatch
@@ -77,14 +99,31 @@ TEST(Protocol, MeshAndFrameResultLayouts) {
   const std::string mesh = encode_mesh_message(m);
   EXPECT_EQ(mesh.size(), 12u + 36u + 12u);
   EXPECT_EQ(message_tag(mesh), Tag::Mesh);
-  const std::string frame = encode_frame_result(9, true, {0.001, 0, 0, 0.002, 1e-6, 1e-7}, m.V);
-  EXPECT_EQ(frame.size(), 40u + 36u);
+  const std::string frame =
+      encode_frame_result(9, {true, false}, {0.001, 0, 0, 0.002, 1e-6, 1e-7, 7, false}, m.V);
+  EXPECT_EQ(frame.size(), 48u + 36u);
   float total_ms = 0;
   std::memcpy(&total_ms, frame.data() + 28, 4);
   EXPECT_FLOAT_EQ(total_ms, 2.0f);
+  uint32_t iterations = 0, converged = 1;
+  std::memcpy(&iterations, frame.data() + 40, 4);
+  std::memcpy(&converged, frame.data() + 44, 4);
+  EXPECT_EQ(iterations, 7u);
+  EXPECT_EQ(converged, 0u);
   float x1 = 0;
-  std::memcpy(&x1, frame.data() + 40 + 12, 4);
+  std::memcpy(&x1, frame.data() + 48 + 12, 4);
   EXPECT_EQ(x1, 1.0f);
+  // A preview frame carries the preview's vertices only, in its order.
+  const PreviewMesh preview{{2, 1}, Faces(0, 3)};
+  const std::string coarse = encode_frame_result(3, {false, true}, {}, m.V, &preview);
+  EXPECT_EQ(coarse.size(), 48u + 24u);
+  uint32_t view = 0;
+  std::memcpy(&view, coarse.data() + 12, 4);
+  EXPECT_EQ(view, 2u);
+  float y0 = 0;
+  std::memcpy(&y0, coarse.data() + 48 + 4, 4);
+  EXPECT_EQ(y0, 1.0f);  // vertex 2's y
+  EXPECT_EQ(encode_preview(preview).size(), 12u + 8u);
   EXPECT_THROW(message_tag("ab"), InputError);
 }
 
