@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs what specdeform needs on Debian 12 (idempotent), then configures and builds it: the
-# C++ library, program, tests and benchmarks, and the browser editor (web/dist, with Vite).
+# C++ library, program, tests and benchmarks, the Python bindings (build/python), and the browser
+# editor (web/dist, with Vite).
 # Usage: scripts/setup.sh [build-dir]      (default: build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -8,7 +9,8 @@ build=${1:-build}
 
 packages=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libopenblas-dev
           libspectra-dev libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev libboost-dev
-          libcgal-dev)
+          libcgal-dev python3-dev pybind11-dev python3-numpy python3-scipy python3-pytest
+          python3-matplotlib)
 command -v npm >/dev/null || packages+=(nodejs npm)
 scripts/apt_install.sh "${packages[@]}"
 
@@ -24,5 +26,6 @@ if [ ! web/node_modules/.package-lock.json -nt web/package-lock.json ]; then
 fi
 (cd web && npm run --silent build >/dev/null)
 
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+# The Python bindings for Debian's python3, which sees Debian's numpy and scipy.
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
 cmake --build "$build" -j "$(nproc)"

@@ -1,0 +1,236 @@
+#include <chrono>
+#include <mutex>
+#include <optional>
+
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include "bindings.h"
+#include "convert.h"
+#include "harmonics.h"
+#include "options.h"
+#include "specdeform/deform/scene.h"
+#include "specdeform/deform/spectral_deformer.h"
+#include "specdeform/exceptions.h"
+
+namespace specdeform::python {
+
+namespace {
+
+// SpectralDeformer for Python: its calls run without the GIL, one at a time.
+struct Deformer {
+  std::unique_ptr<SpectralDeformer> deformer;
+  double basis_seconds = 0.0;
+  std::mutex mutex;
+};
+
+Selection to_selection(py::handle handles, py::handle fixed, Eigen::Index n) {
+  if (py::isinstance<py::str>(handles) || !py::isinstance<py::iterable>(handles)) {
+    throw InputError("handles: expected a list of vertex index arrays, one per handle group");
+  }
+  Selection s;
+  for (py::handle group : handles) {
+    s.handles.push_back(to_indices(group, n, "handles[" + std::to_string(s.handles.size()) + "]"));
+  }
+  s.fixed = to_indices(fixed, n, "fixed");
+  return s;
+}
+
+py::array index_array(const std::vector<int>& v) {
+  return to_array(Eigen::VectorXi(Eigen::Map<const Eigen::VectorXi>(v.data(), v.size())));
+}
+
+// The scene `path` (JSON, or a .sel or .dmat with the .def `transforms`) of the mesh file `mesh`:
+// the mesh, the selection in its numbering, one transform per handle group, the settings.
+py::dict read_scene_files(const std::filesystem::path& path, const std::filesystem::path& mesh,
+                          const std::optional<std::filesystem::path>& transforms) {
+  check_readable(mesh);
+  check_readable(path);
+  const std::string kind = path.extension().string();
+  if (kind != ".json" && kind != ".sel" && kind != ".dmat") {
+    throw InputError(path.string() + ": a scene is a .json, .sel or .dmat file");
+  }
+  if (kind != ".json" && !transforms) {
+    throw InputError(path.string() + ": a " + kind + " selection needs its transforms (a .def)");
+  }
+  if (transforms) check_readable(*transforms);
+  LoadedMesh loaded;
+  Scene scene;
+  {
+    py::gil_scoped_release release;
+    loaded = read_mesh(mesh);
+    const int file_vertices = static_cast<int>(loaded.info.file_vertices.rows());
+    if (kind == ".json") {
+      scene = read_scene(path, loaded.info.file_vertices);
+    } else {
+      scene.selection =
+          kind == ".sel" ? read_sel(path, file_vertices) : read_dmat(path, file_vertices);
+      scene.transforms = read_def(*transforms);
+    }
+  }
+  const Selection selection = to_mesh_numbering(scene.selection, loaded.info);
+  py::list handles, matrices;
+  for (const std::vector<int>& group : selection.handles) handles.append(index_array(group));
+  for (const Eigen::Affine3d& t : match_transforms(scene.selection, scene.transforms)) {
+    matrices.append(to_array(Eigen::Matrix4d(t.matrix())));
+  }
+  py::dict d;
+  d["V"] = to_array(std::move(loaded.mesh.V));
+  d["F"] = to_array(std::move(loaded.mesh.F));
+  d["info"] = std::move(loaded.info);
+  d["handles"] = handles;
+  d["fixed"] = index_array(selection.fixed);
+  d["transforms"] = matrices;
+  d["modes"] = scene.modes;
+  d["options"] = to_dict(scene.options);
+  return d;
+}
+
+}  // namespace
+
+void bind_deform(py::module_& m) {
+  py::class_<Deformer>(m, "SpectralDeformer", R"(Spectral mesh deformation (Rong, Cao & Guo 2008).
+
+Built once per mesh: the basis of the first `modes` manifold harmonics (default 100), computed
+unless `basis` gives it, the smooth base and the reduced system; then set_selection() once per
+selection and solve() once per frame.)")
+      .def(py::init([](py::handle V, py::handle F, std::optional<int> modes, py::handle basis,
+                       std::optional<std::string> mass, std::optional<std::filesystem::path> cache,
+                       py::handle progress, double tolerance, const py::kwargs& keywords) {
+             TriangleMesh mesh = to_mesh(V, F);
+             const DeformOptions options = to_options(keywords);
+             const std::optional<MassType> mass_type =
+                 mass ? std::optional(mass_from_name(*mass)) : std::nullopt;
+             auto d = std::make_unique<Deformer>();
+             std::shared_ptr<const ManifoldHarmonics> shared;
+             if (!basis.is_none()) {
+               shared = to_basis(basis, mesh, mass_type, modes);
+             } else if (options.solver == DeformSolver::Spectral) {
+               ManifoldHarmonicsOptions o;
+               o.num_modes = modes.value_or(100);
+               o.mass = mass_type.value_or(MassType::Lumped);
+               o.tolerance = tolerance;
+               const auto start = std::chrono::steady_clock::now();
+               shared = obtain_basis(mesh, o, cache, progress);
+               d->basis_seconds =
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+             }
+             py::gil_scoped_release release;
+             d->deformer = std::make_unique<SpectralDeformer>(std::move(mesh), shared, options);
+             return d;
+           }),
+           py::arg("V"), py::arg("F"), py::arg("modes") = py::none(), py::arg("basis") = py::none(),
+           py::kw_only(), py::arg("mass") = py::none(), py::arg("cache") = py::none(),
+           py::arg("progress") = py::none(),
+           py::arg("tolerance") = ManifoldHarmonicsOptions{}.tolerance,
+           R"(V (n, 3), F (f, 3); modes: the harmonics used (default 100, or all of `basis`);
+basis: (evals, evecs) from manifold_harmonics (shared, not copied) or any M-orthonormal
+eigenpairs (copied); mass, cache, progress, tolerance: as manifold_harmonics takes them, when
+the basis is computed here. With solver="spatial" and no basis, the base is the mesh itself.
+Keywords: the deformation options (energy="linear"|"arap", ks, kb, constraint_weight,
+detail="none"|"displacement"|"frames"|"transfer", solver="spectral"|"spatial",
+constraints="soft"|"hard", unconstrained="keep"|"error", float32_basis, and for ARAP
+iterations, clusters, arap_tolerance, anderson_window, warm_start).)")
+      .def(
+          "set_selection",
+          [](Deformer& d, py::handle handles, py::handle fixed) {
+            const Selection s = to_selection(handles, fixed, d.deformer->mesh().num_vertices());
+            py::gil_scoped_release release;
+            const std::lock_guard lock(d.mutex);
+            d.deformer->set_selection(s);
+          },
+          py::arg("handles"), py::arg("fixed") = py::tuple(),
+          R"(handles: one vertex index array (or boolean mask) per handle group; fixed: the
+vertices held in place. A vertex may belong to one group only.)")
+      .def(
+          "solve",
+          [](Deformer& d, py::handle transforms) {
+            const std::vector<Eigen::Affine3d> t = to_transforms(transforms);
+            Vertices result;
+            {
+              py::gil_scoped_release release;
+              const std::lock_guard lock(d.mutex);
+              result = d.deformer->solve(t);
+            }
+            return to_array(std::move(result));
+          },
+          py::arg("transforms"),
+          R"(The deformed mesh (n, 3) for one 4 x 4 affine transform per handle group (a list, a
+(k, 4, 4) array, or one matrix for one group).)")
+      .def(
+          "constraint_error",
+          [](Deformer& d, py::handle X) {
+            const std::lock_guard lock(d.mutex);
+            const ConstraintError e = d.deformer->constraint_error(to_vertices(X, "X"));
+            return py::dict(py::arg("max") = e.max, py::arg("rms") = e.rms);
+          },
+          py::arg("X"),
+          "Distances of a solve() result's constrained vertices to their targets, over the "
+          "bounding-box diagonal: {'max', 'rms'}.")
+      .def_property_readonly(
+          "base",
+          [](py::object self) { return view(self.cast<Deformer&>().deformer->base(), self); },
+          "The smooth base s (n, 3): the mesh low-passed to the basis (read-only).")
+      .def_property_readonly(
+          "deformed_base",
+          [](Deformer& d) {
+            const std::lock_guard lock(d.mutex);
+            return to_array(Vertices(d.deformer->deformed_base()));
+          },
+          "The deformed smooth base s' of the last solve (n, 3).")
+      .def_property_readonly(
+          "basis",
+          [](Deformer& d) -> py::object {
+            const std::shared_ptr<const ManifoldHarmonics>& b = d.deformer->basis();
+            if (!b || b->basis.cols() == 0) return py::none();
+            return eigenpairs(b);
+          },
+          "(evals, evecs), read-only views of the shared basis; None without one.")
+      .def_property_readonly(
+          "options", [](Deformer& d) { return to_dict(d.deformer->options()); },
+          "The deformation options, as keywords.")
+      .def_property_readonly(
+          "timings",
+          [](Deformer& d) {
+            const std::lock_guard lock(d.mutex);
+            const SetupTimings& s = d.deformer->setup_timings();
+            const FrameTimings& f = d.deformer->frame_timings();
+            py::dict t;
+            t["basis"] = d.basis_seconds;
+            t["reduced_system"] = s.reduced_system;
+            t["detail_factorization"] = s.detail_factorization;
+            t["selection"] = s.selection;
+            t["frame"] = py::dict(py::arg("reduced_solve") = f.reduced_solve,
+                                  py::arg("inverse_transform") = f.inverse_transform,
+                                  py::arg("detail") = f.detail, py::arg("total") = f.total);
+            return t;
+          },
+          "Seconds per stage, as `specdeform deform --json` reports them: basis, "
+          "reduced_system, detail_factorization, selection, frame {reduced_solve, "
+          "inverse_transform, detail, total} (the last solve).")
+      .def_property_readonly(
+          "report",
+          [](Deformer& d) {
+            const std::lock_guard lock(d.mutex);
+            const ArapReport& a = d.deformer->arap_report();
+            py::dict r;
+            r["energy"] = std::string(name(d.deformer->options().energy));
+            r["iterations"] = a.iterations;
+            r["accelerated"] = a.accelerated;
+            r["arap_energy"] = a.energy;
+            r["relative_change"] = a.relative_change;
+            r["converged"] = a.converged;
+            r["clusters"] = d.deformer->rotation_clusters();
+            r["held_pieces"] = d.deformer->held_pieces();
+            return r;
+          },
+          R"(The last solve: ARAP's iterations (Anderson steps kept: accelerated), its energy
+and last relative change, whether it converged (the linear energy: 0 iterations, converged),
+the rotation clusters, and held_pieces (components without a handle or fixed vertex, held in
+place by the last selection).)");
+
+  m.def("_read_scene", &read_scene_files, py::arg("path"), py::arg("mesh"),
+        py::arg("transforms") = py::none());
+}
+
+}  // namespace specdeform::python
