@@ -12,7 +12,7 @@ import numpy as np
 from ._specdeform import InputError, MeshReadInfo, _read_scene
 
 
-@dataclass
+@dataclass(eq=False)
 class Scene:
     """What SpectralDeformer and its set_selection() and solve() take, read from scene files.
 

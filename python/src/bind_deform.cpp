@@ -208,6 +208,14 @@ vertices held in place. A vertex may belong to one group only.)")
           "Seconds per stage, as `specdeform deform --json` reports them: basis, "
           "reduced_system, detail_factorization, selection, frame {reduced_solve, "
           "inverse_transform, detail, total} (the last solve).")
+      .def("__repr__",
+           [](Deformer& d) {
+             const SpectralDeformer& s = *d.deformer;
+             const auto& b = s.basis();
+             return py::str("SpectralDeformer(n={}, modes={}, energy='{}', solver='{}')")
+                 .format(s.mesh().num_vertices(), b ? b->basis.cols() : 0, name(s.options().energy),
+                         name(s.options().solver));
+           })
       .def_property_readonly(
           "report",
           [](Deformer& d) {

@@ -1,3 +1,5 @@
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstdio>
 
@@ -24,6 +26,18 @@ void check_readable(const std::filesystem::path& path) {
     throw py::error_already_set();
   }
   std::fclose(file);
+}
+
+void check_writable(const std::filesystem::path& path) {
+  const std::filesystem::path folder = path.has_parent_path() ? path.parent_path() : ".";
+  std::error_code ec;
+  if (std::filesystem::exists(folder, ec) && !std::filesystem::is_directory(folder, ec)) {
+    errno = ENOTDIR;
+  } else if (access(folder.c_str(), W_OK) == 0) {
+    return;
+  }
+  PyErr_SetFromErrnoWithFilename(PyExc_OSError, path.c_str());
+  throw py::error_already_set();
 }
 
 namespace {
@@ -98,6 +112,7 @@ Raises OSError if the file cannot be opened, InputError if it is malformed.)");
   m.def(
       "write_mesh",
       [](const std::filesystem::path& path, py::handle V, py::handle F, const MeshReadInfo* info) {
+        check_writable(path);
         TriangleMesh mesh = to_mesh(V, F);
         if (info != nullptr) {
           if (mesh.num_vertices() != static_cast<int>(info->vertex_to_file.size())) {

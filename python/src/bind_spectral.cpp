@@ -157,6 +157,7 @@ Raises SolverError if the eigensolver does not converge.)");
       "save_basis",
       [](const std::filesystem::path& path, py::handle basis, py::handle V, py::handle F,
          bool float32, std::optional<std::string> mass) {
+        check_writable(path);
         const TriangleMesh mesh = to_mesh(V, F);
         const auto h =
             to_basis(basis, mesh, mass ? std::optional(mass_from_name(*mass)) : std::nullopt, {});

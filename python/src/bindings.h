@@ -16,5 +16,7 @@ void bind_deform(py::module_& m);    // SpectralDeformer, scenes
 // Raises the OSError of opening `path` for reading (FileNotFoundError, PermissionError, ...) as a
 // Python exception, if there is one.
 void check_readable(const std::filesystem::path& path);
+// The same for creating `path`: its folder must exist and be writable.
+void check_writable(const std::filesystem::path& path);
 
 }  // namespace specdeform::python

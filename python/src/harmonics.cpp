@@ -147,6 +147,7 @@ std::shared_ptr<const ManifoldHarmonics> obtain_basis(
     }
     return first_modes(std::move(h), options.num_modes, path.string());
   }
+  if (!path.empty()) check_writable(path);
   ManifoldHarmonicsOptions o = options;
   o.progress = python_progress(progress);
   auto h = std::make_shared<ManifoldHarmonics>();

@@ -57,6 +57,16 @@ def test_missing_file_is_an_os_error(tmp_path):
         specdeform.read_mesh(tmp_path)
 
 
+def test_unwritable_place_is_an_os_error(tmp_path, bar):
+    with pytest.raises(FileNotFoundError):
+        specdeform.write_mesh(tmp_path / "missing" / "bar.off", *bar)
+    (tmp_path / "file").write_text("")
+    with pytest.raises(NotADirectoryError):
+        specdeform.write_mesh(tmp_path / "file" / "bar.off", *bar)
+    with pytest.raises(specdeform.InputError, match="unknown mesh format '.abc'"):
+        specdeform.write_mesh(tmp_path / "bar.abc", *bar)
+
+
 def test_malformed_file_is_an_input_error(tmp_path):
     path = tmp_path / "trunc.off"
     path.write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n")
