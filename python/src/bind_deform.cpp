@@ -107,7 +107,7 @@ selection and solve() once per frame.)")
                shared = to_basis(basis, mesh, mass_type, modes);
              } else if (options.solver == DeformSolver::Spectral) {
                ManifoldHarmonicsOptions o;
-               o.num_modes = modes.value_or(100);
+               o.num_modes = modes.value_or(o.num_modes);
                o.mass = mass_type.value_or(MassType::Lumped);
                o.tolerance = tolerance;
                const auto start = std::chrono::steady_clock::now();
