@@ -204,7 +204,7 @@ void EditorSession::dispatch(bool binary, std::string_view message) {
   const int n = s.loaded.mesh.num_vertices();
   switch (tag) {
     case Tag::Selection:
-      return set_edit(decode_selection(message, n), true);
+      return set_edit(decode_selection(message, n), true, false);
     case Tag::Frame: {
       if (!s.has_handles) throw InputError("frame message: select a handle first");
       const FrameRequest f = decode_frame(message, static_cast<int>(s.edit.transforms.size()));
@@ -229,8 +229,7 @@ void EditorSession::dispatch(bool binary, std::string_view message) {
       edit.transforms.assign(groups, Eigen::Affine3d::Identity());
       edit.pinned.assign(groups, false);
       edit.fit.assign(groups, false);
-      set_edit(std::move(edit), true);
-      return send_selection();
+      return set_edit(std::move(edit), true, true);
     }
     case Tag::SceneFile:
       return open_scene(decode_file(message));
@@ -255,9 +254,8 @@ void EditorSession::text_message(std::string_view message) {
     send_mesh();
     send_ready();
     send_selection();
-    send_state();
     if (s.has_handles) solve_and_send();
-    return;
+    return send_state();
   }
   if (type == "settings") return change_settings(message);
   if (type == "commit") {
@@ -373,11 +371,11 @@ void EditorSession::change_settings(std::string_view message) {
     config_.options = o;
   }
   s.base_view = base_view;
-  send_ready();
   solve_and_send();
+  send_ready();
 }
 
-void EditorSession::set_edit(GroupSelection edit, bool record) {
+void EditorSession::set_edit(GroupSelection edit, bool record, bool echo) {
   State& s = *state_;
   const size_t groups = edit.selection.handles.size();
   if (edit.transforms.size() != groups || edit.pinned.size() != groups) {
@@ -409,8 +407,9 @@ void EditorSession::set_edit(GroupSelection edit, bool record) {
   s.edit = std::move(edit);
   if (!s.has_handles) s.result = s.rest();
   if (record) push_history();
-  send_state();
+  if (echo) send_selection();
   if (s.has_handles) solve_and_send();
+  send_state();
 }
 
 void EditorSession::push_history() {
@@ -445,8 +444,7 @@ void EditorSession::restore(size_t entry) {
     send_ready();
   }
   s.at = entry;
-  set_edit(s.history[entry].edit, false);
-  send_selection();
+  set_edit(s.history[entry].edit, false, true);
 }
 
 void EditorSession::apply_pose() {
@@ -490,8 +488,7 @@ void EditorSession::apply_pose() {
   s.result = s.rest();
   send_mesh();
   send_ready();
-  set_edit(std::move(edit), true);
-  send_selection();
+  set_edit(std::move(edit), true, true);
 }
 
 void EditorSession::open_scene(const NamedFile& file) {
@@ -529,8 +526,7 @@ void EditorSession::open_scene(const NamedFile& file) {
                    {"detail", name(o.detail)},
                    {"constraints", name(o.constraints)}};
   change_settings(dump(settings));
-  set_edit(std::move(edit), true);
-  send_selection();
+  set_edit(std::move(edit), true, true);
 }
 
 void EditorSession::open(LoadedMesh mesh, std::string name) {

@@ -24,7 +24,7 @@
 //      "setup": {...}, "arap_clusters"}         after a mesh message or a settings request
 //     {"type": "state", "groups": [{"vertices", "pinned", "transform": 16 numbers}], "fixed",
 //      "undo", "redo", "selection_seconds", "pin_error", "held_pieces", "pose"}
-//                                               after every edit (the terminal reply of one)
+//                                               after every edit, last (its frame comes first)
 //     {"type": "empty"}                         no mesh is open (a failed or cancelled start)
 //     {"type": "error", "message": one line, "request": the request's type, "cancelled": b}
 // Every request is answered: by its reply (ready, state, file, preview, a frame), or by an
@@ -110,7 +110,8 @@ class EditorSession {
   void dispatch(bool binary, std::string_view message);
   void text_message(std::string_view message);
   void change_settings(std::string_view message);
-  void set_edit(GroupSelection edit, bool record);
+  // `record`: an undo step; `echo`: the selection is sent back (it did not come from the browser).
+  void set_edit(GroupSelection edit, bool record, bool echo);
   void push_history();
   void commit();  // an undo step if the transforms moved since the last one
   void restore(size_t entry);

@@ -2,9 +2,10 @@
 import { spawn } from 'node:child_process';
 import { chromium } from 'playwright-core';
 
-// Starts `BINARY edit --port 0 --no-cache ARGS...`; `url` resolves to the address it prints.
-export function startEditor(binary, editArgs = []) {
-  const server = spawn(binary, ['edit', '--port', '0', '--no-cache', ...editArgs], {
+// Starts `BINARY edit --port PORT --no-cache ARGS...` (PORT 0: any free one); `url` resolves to
+// the address it prints, once it serves the page.
+export function startEditor(binary, editArgs = [], port = 0) {
+  const server = spawn(binary, ['edit', '--port', String(port), '--no-cache', ...editArgs], {
     stdio: ['ignore', 'pipe', 'inherit'],
   });
   const url = new Promise((resolveUrl, reject) => {

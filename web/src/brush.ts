@@ -1,9 +1,12 @@
 // Brush selection: the vertices within a radius of a point on the surface, measured in space
 // (Euclidean) or along the mesh's edges (geodesic, Dijkstra over the edge graph, so the brush
-// does not jump across a thin gap to another part of the shape).
+// does not jump across a thin gap to another part of the shape). Typed arrays throughout, and
+// per-query work proportional to the region found, not to the mesh.
 export class Brush {
   private readonly offsets: Int32Array; // CSR adjacency of the edge graph
   private readonly neighbours: Int32Array;
+  private readonly distance: Float64Array; // Infinity outside the current query
+  private readonly settled: Uint8Array;
 
   constructor(vertexCount: number, indices: Uint32Array) {
     const degree = new Int32Array(vertexCount + 1);
@@ -22,9 +25,11 @@ export class Brush {
         this.neighbours[fill[b]++] = a;
       }
     }
+    this.distance = new Float64Array(vertexCount).fill(Infinity);
+    this.settled = new Uint8Array(vertexCount);
   }
 
-  euclidean(positions: Float32Array, cx: number, cy: number, cz: number, radius: number): number[] {
+  euclidean(positions: Float32Array, cx: number, cy: number, cz: number, radius: number): Uint32Array {
     const out: number[] = [];
     const r2 = radius * radius;
     for (let v = 0; 3 * v < positions.length; ++v) {
@@ -33,63 +38,93 @@ export class Brush {
       const dz = positions[3 * v + 2] - cz;
       if (dx * dx + dy * dy + dz * dz <= r2) out.push(v);
     }
-    return out;
+    return Uint32Array.from(out);
   }
 
-  geodesic(positions: Float32Array, start: number, radius: number): number[] {
-    const distance = new Map<number, number>([[start, 0]]);
-    const heap: [number, number][] = [[0, start]];
+  geodesic(positions: Float32Array, start: number, radius: number): Uint32Array {
+    const { distance, settled, offsets, neighbours } = this;
+    const heap = new Heap();
+    const touched: number[] = [start];
     const done: number[] = [];
-    const settled = new Set<number>();
-    while (heap.length > 0) {
-      const [d, v] = pop(heap);
-      if (settled.has(v)) continue;
-      settled.add(v);
+    distance[start] = 0;
+    heap.push(0, start);
+    while (heap.size > 0) {
+      const d = heap.topKey();
+      const v = heap.pop();
+      if (settled[v]) continue;
+      settled[v] = 1;
       done.push(v);
-      for (let k = this.offsets[v]; k < this.offsets[v + 1]; ++k) {
-        const w = this.neighbours[k];
-        if (settled.has(w)) continue;
+      for (let k = offsets[v]; k < offsets[v + 1]; ++k) {
+        const w = neighbours[k];
+        if (settled[w]) continue;
         const dx = positions[3 * v] - positions[3 * w];
         const dy = positions[3 * v + 1] - positions[3 * w + 1];
         const dz = positions[3 * v + 2] - positions[3 * w + 2];
         const dw = d + Math.sqrt(dx * dx + dy * dy + dz * dz);
-        if (dw <= radius && dw < (distance.get(w) ?? Infinity)) {
-          distance.set(w, dw);
-          push(heap, [dw, w]);
+        if (dw <= radius && dw < distance[w]) {
+          if (distance[w] === Infinity) touched.push(w);
+          distance[w] = dw;
+          heap.push(dw, w);
         }
       }
     }
-    return done;
-  }
-}
-
-function push(heap: [number, number][], item: [number, number]): void {
-  heap.push(item);
-  let i = heap.length - 1;
-  while (i > 0) {
-    const parent = (i - 1) >> 1;
-    if (heap[parent][0] <= heap[i][0]) break;
-    [heap[parent], heap[i]] = [heap[i], heap[parent]];
-    i = parent;
-  }
-}
-
-function pop(heap: [number, number][]): [number, number] {
-  const top = heap[0];
-  const last = heap.pop()!;
-  if (heap.length > 0) {
-    heap[0] = last;
-    let i = 0;
-    for (;;) {
-      const l = 2 * i + 1;
-      const r = l + 1;
-      let m = i;
-      if (l < heap.length && heap[l][0] < heap[m][0]) m = l;
-      if (r < heap.length && heap[r][0] < heap[m][0]) m = r;
-      if (m === i) break;
-      [heap[m], heap[i]] = [heap[i], heap[m]];
-      i = m;
+    for (const v of touched) {
+      distance[v] = Infinity;
+      settled[v] = 0;
     }
+    return Uint32Array.from(done);
   }
-  return top;
+}
+
+// A binary min-heap of (key, vertex) in two parallel arrays.
+class Heap {
+  private keys: number[] = [];
+  private items: number[] = [];
+
+  get size(): number {
+    return this.items.length;
+  }
+
+  topKey(): number {
+    return this.keys[0];
+  }
+
+  push(key: number, item: number): void {
+    const { keys, items } = this;
+    let i = items.length;
+    keys.push(key);
+    items.push(item);
+    while (i > 0) {
+      const parent = (i - 1) >> 1;
+      if (keys[parent] <= key) break;
+      keys[i] = keys[parent];
+      items[i] = items[parent];
+      i = parent;
+    }
+    keys[i] = key;
+    items[i] = item;
+  }
+
+  pop(): number {
+    const { keys, items } = this;
+    const top = items[0];
+    const key = keys.pop()!;
+    const item = items.pop()!;
+    const n = items.length;
+    if (n > 0) {
+      let i = 0;
+      for (;;) {
+        const l = 2 * i + 1;
+        if (l >= n) break;
+        const m = l + 1 < n && keys[l + 1] < keys[l] ? l + 1 : l;
+        if (keys[m] >= key) break;
+        keys[i] = keys[m];
+        items[i] = items[m];
+        i = m;
+      }
+      keys[i] = key;
+      items[i] = item;
+    }
+    return top;
+  }
 }

@@ -1,20 +1,99 @@
-// The editor's WebSocket messages; the layouts are documented in apps/server/protocol.h.
-// Little-endian, every array aligned to its element size, read with typed arrays in place.
+// The editor's WebSocket messages, typed: the binary layouts of apps/server/protocol.h and the
+// JSON messages of apps/server/editor_session.h (tests/server/web_protocol_test.cpp checks that
+// the tags below match the server's). Little-endian, every array aligned to its element size,
+// read with typed arrays in place.
 
 export const Tag = {
   Selection: 1,
   Frame: 2,
   MeshFile: 3,
   SelectionFile: 4,
+  SceneFile: 5,
   Mesh: 101,
   FrameResult: 102,
   File: 103,
   SelectionResult: 104,
+  Preview: 105,
 } as const;
 
+export type FileTag = typeof Tag.MeshFile | typeof Tag.SelectionFile | typeof Tag.SceneFile;
+
+export type Matrix = number[]; // 4 x 4, row-major
+
+export type Energy = 'linear' | 'arap';
+export type Detail = 'none' | 'displacement' | 'frames' | 'transfer';
+export type Constraints = 'soft' | 'hard';
+export type View = 'detailed' | 'base';
+
+export interface Settings {
+  energy: Energy;
+  ks: number;
+  kb: number;
+  detail: Detail;
+  constraints: Constraints;
+  view: View;
+}
+
+// ---------------------------------------------------------------- JSON, server -> browser
+
+export interface ProgressMessage {
+  type: 'progress';
+  stage: string;
+  fraction: number;
+  cancellable: boolean;
+}
+
+export interface ReadyMessage {
+  type: 'ready';
+  name: string;
+  vertices: number;
+  faces: number;
+  diagonal: number;
+  mesh_id: string;
+  modes: number;
+  pose: number;
+  settings: Settings;
+  basis: { seconds: number; source: 'computed' | 'cache' | 'reused'; residual: number; warning: string };
+  setup: { reduced_system: number; detail_factorization: number; selection: number };
+  arap_clusters: number;
+}
+
+export interface StateMessage {
+  type: 'state';
+  groups: { vertices: number; pinned: boolean; transform: Matrix }[];
+  fixed: number;
+  undo: boolean;
+  redo: boolean;
+  selection_seconds: number;
+  pin_error: number;
+  held_pieces: number;
+  pose: number;
+}
+
+export interface ErrorMessage {
+  type: 'error';
+  message: string;
+  request: string;
+  cancelled: boolean;
+}
+
+export type ServerText = ProgressMessage | ReadyMessage | StateMessage | ErrorMessage | { type: 'empty' };
+
+// ---------------------------------------------------------------- JSON, browser -> server
+
+export type ClientText =
+  | { type: 'hello' | 'open_demo' | 'commit' | 'undo' | 'redo' | 'apply_pose' | 'export_scene' | 'cancel' }
+  | ({ type: 'settings' } & Partial<Settings> & { modes?: number })
+  | { type: 'preview'; vertices: number }
+  | { type: 'export_mesh'; format: 'obj' | 'off' | 'ply' | 'stl' };
+
+// ---------------------------------------------------------------- binary
+
+// Handle groups (vertex lists in mesh numbering) with their transforms and flags, and the fixed
+// vertices. `fit`: the server fits a pinned group's transform to where its vertices are shown.
 export interface Selection {
-  handles: number[][]; // vertex indices of each handle group
-  fixed: number[];
+  groups: { vertices: Uint32Array; transform: Matrix; pinned: boolean; fit?: boolean }[];
+  fixed: Uint32Array;
 }
 
 export interface MeshMessage {
@@ -22,12 +101,19 @@ export interface MeshMessage {
   indices: Uint32Array; // 3 T
 }
 
+export interface PreviewMessage {
+  vertices: Uint32Array; // mesh vertex of each preview vertex
+  indices: Uint32Array; // 3 T, preview numbering
+}
+
 export interface FrameResult {
   seq: number;
   baseView: boolean;
+  preview: boolean; // positions of the preview's vertices only
   ms: { reducedSolve: number; inverseTransform: number; detail: number; total: number };
   error: { max: number; rms: number };
-  positions: Float32Array; // 3 n
+  arap: { iterations: number; converged: boolean };
+  positions: Float32Array;
 }
 
 export interface NamedFile {
@@ -40,45 +126,58 @@ export function tagOf(buffer: ArrayBuffer): number {
 }
 
 export function encodeSelection(s: Selection): ArrayBuffer {
-  const total = s.fixed.length + s.handles.reduce((a, g) => a + g.length, 0);
-  const out = new Uint32Array(3 + s.handles.length + total);
-  out[0] = Tag.Selection;
-  out[1] = s.handles.length;
-  out[2] = s.fixed.length;
-  s.handles.forEach((g, i) => (out[3 + i] = g.length));
-  let k = 3 + s.handles.length;
-  for (const v of s.fixed) out[k++] = v;
-  for (const g of s.handles) for (const v of g) out[k++] = v;
-  return out.buffer;
+  const G = s.groups.length;
+  const total = s.fixed.length + s.groups.reduce((a, g) => a + g.vertices.length, 0);
+  const head = 16 + 8 * G; // a multiple of 8: the transforms follow aligned
+  const buffer = new ArrayBuffer(head + 128 * G + 4 * total);
+  const u = new Uint32Array(buffer, 0, head / 4);
+  u.set([Tag.Selection, G, s.fixed.length, 0]);
+  s.groups.forEach((g, i) => {
+    u[4 + i] = g.vertices.length;
+    u[4 + G + i] = (g.pinned ? 1 : 0) | (g.fit ? 2 : 0);
+  });
+  const m = new Float64Array(buffer, head, 16 * G);
+  s.groups.forEach((g, i) => m.set(g.transform, 16 * i));
+  const lists = new Uint32Array(buffer, head + 128 * G, total);
+  lists.set(s.fixed);
+  let k = s.fixed.length;
+  for (const g of s.groups) {
+    lists.set(g.vertices, k);
+    k += g.vertices.length;
+  }
+  return buffer;
 }
 
 export function decodeSelection(buffer: ArrayBuffer): Selection {
-  const u = new Uint32Array(buffer);
-  const groups = u[1];
-  let k = 3 + groups;
-  const fixed = Array.from(u.subarray(k, k + u[2]));
-  k += u[2];
-  const handles: number[][] = [];
-  for (let g = 0; g < groups; ++g) {
-    handles.push(Array.from(u.subarray(k, k + u[3 + g])));
-    k += u[3 + g];
+  const [, G, F] = new Uint32Array(buffer, 0, 4);
+  const u = new Uint32Array(buffer, 0, 4 + 2 * G);
+  const head = 16 + 8 * G;
+  const m = new Float64Array(buffer, head, 16 * G);
+  let k = (head + 128 * G) / 4;
+  const all = new Uint32Array(buffer);
+  const fixed = all.slice(k, k + F);
+  k += F;
+  const groups: Selection['groups'] = [];
+  for (let g = 0; g < G; ++g) {
+    groups.push({
+      vertices: all.slice(k, k + u[4 + g]),
+      transform: Array.from(m.subarray(16 * g, 16 * g + 16)),
+      pinned: (u[4 + G + g] & 1) !== 0,
+    });
+    k += u[4 + g];
   }
-  return { handles, fixed };
+  return { groups, fixed };
 }
 
-// `transforms`: one 4 x 4 matrix per handle group, row-major.
-export function encodeFrame(seq: number, transforms: number[][]): ArrayBuffer {
+export function encodeFrame(seq: number, transforms: Matrix[], preview: boolean): ArrayBuffer {
   const buffer = new ArrayBuffer(16 + transforms.length * 128);
-  const head = new Uint32Array(buffer, 0, 4);
-  head[0] = Tag.Frame;
-  head[1] = seq;
-  head[2] = transforms.length;
+  new Uint32Array(buffer, 0, 4).set([Tag.Frame, seq, transforms.length, preview ? 1 : 0]);
   const m = new Float64Array(buffer, 16);
   transforms.forEach((t, g) => m.set(t, 16 * g));
   return buffer;
 }
 
-export function encodeFile(tag: number, name: string, data: ArrayBuffer): ArrayBuffer {
+export function encodeFile(tag: FileTag, name: string, data: ArrayBuffer): ArrayBuffer {
   const nameBytes = new TextEncoder().encode(name);
   const padded = Math.ceil(nameBytes.length / 4) * 4;
   const out = new Uint8Array(8 + padded + data.byteLength);
@@ -103,14 +202,24 @@ export function decodeMesh(buffer: ArrayBuffer): MeshMessage {
   };
 }
 
+export function decodePreview(buffer: ArrayBuffer): PreviewMessage {
+  const [, k, triangles] = new Uint32Array(buffer, 0, 3);
+  return {
+    vertices: new Uint32Array(buffer, 12, k),
+    indices: new Uint32Array(buffer, 12 + 4 * k, 3 * triangles),
+  };
+}
+
 export function decodeFrameResult(buffer: ArrayBuffer): FrameResult {
-  const u = new Uint32Array(buffer, 0, 4);
+  const u = new Uint32Array(buffer, 0, 12);
   const f = new Float32Array(buffer, 16, 6);
   return {
     seq: u[1],
-    baseView: u[3] === 1,
+    baseView: (u[3] & 1) !== 0,
+    preview: (u[3] & 2) !== 0,
     ms: { reducedSolve: f[0], inverseTransform: f[1], detail: f[2], total: f[3] },
     error: { max: f[4], rms: f[5] },
-    positions: new Float32Array(buffer, 40, 3 * u[2]),
+    arap: { iterations: u[10], converged: u[11] === 1 },
+    positions: new Float32Array(buffer, 48, 3 * u[2]),
   };
 }

@@ -1,12 +1,15 @@
 // The three.js view: the shaded mesh (smooth normals, per-vertex selection colours, optional
-// wireframe), orbit / pan / zoom, and a translate / rotate gizmo on the active handle group.
+// wireframe), a coarse preview mesh drawn instead during drags of large meshes, orbit / pan /
+// zoom on the right and middle buttons (or Alt + left), a translate / rotate gizmo beside the
+// active handle group, the brush's circle, and picking with a BVH (three-mesh-bvh).
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TransformControls } from 'three/addons/controls/TransformControls.js';
-import { vertexNormals } from './normals';
+import { MeshBVH } from 'three-mesh-bvh';
 
 export interface Hit {
   point: THREE.Vector3;
+  normal: THREE.Vector3;
   vertex: number; // the hit triangle's corner nearest to the point
 }
 
@@ -22,9 +25,15 @@ export class Viewer {
   private readonly geometry = new THREE.BufferGeometry();
   private readonly surface: THREE.Mesh;
   private readonly wireframe: THREE.Mesh;
+  private readonly coarseGeometry = new THREE.BufferGeometry();
+  private readonly coarse: THREE.Mesh;
+  private readonly ring: THREE.LineLoop;
   private readonly raycaster = new THREE.Raycaster();
+  private bvh: MeshBVH | null = null;
+  private bvhStale = false;
+  private coarseVertices = new Uint32Array(0); // mesh vertex of each preview vertex
+  private home = { position: new THREE.Vector3(), target: new THREE.Vector3() };
   private renderQueued = false;
-  private boundsStale = false;
 
   constructor(private readonly container: HTMLElement) {
     // A software renderer (no GPU) spends most of a frame on multisampling: it goes without.
@@ -38,24 +47,34 @@ export class Viewer {
     this.camera.add(light);
     this.scene.add(this.camera);
 
-    this.surface = new THREE.Mesh(
-      this.geometry,
-      new THREE.MeshLambertMaterial({ vertexColors: true }),
-    );
+    const material = new THREE.MeshLambertMaterial({ vertexColors: true });
+    this.surface = new THREE.Mesh(this.geometry, material);
+    this.coarse = new THREE.Mesh(this.coarseGeometry, material);
+    this.coarse.visible = false;
     this.wireframe = new THREE.Mesh(
       this.geometry,
       new THREE.MeshBasicMaterial({ color: 0x20242c, wireframe: true, transparent: true, opacity: 0.25 }),
     );
     this.wireframe.visible = false;
-    this.surface.frustumCulled = this.wireframe.frustumCulled = false;
-    this.scene.add(this.surface, this.wireframe, this.pivot);
+    this.surface.frustumCulled = this.wireframe.frustumCulled = this.coarse.frustumCulled = false;
+    const circle = new THREE.BufferGeometry().setFromPoints(
+      Array.from({ length: 64 }, (_, i) => new THREE.Vector3(Math.cos((i * Math.PI) / 32), Math.sin((i * Math.PI) / 32), 0)),
+    );
+    this.ring = new THREE.LineLoop(circle, new THREE.LineBasicMaterial({ color: 0x1d2026, depthTest: false, transparent: true }));
+    this.ring.visible = false;
+    this.ring.renderOrder = 1;
+    this.scene.add(this.surface, this.coarse, this.wireframe, this.pivot, this.ring);
 
     this.orbit = new OrbitControls(this.camera, this.renderer.domElement);
+    // The left button paints and drags; orbiting is on the right button (or Alt + left, which
+    // the interaction switches on), panning on the middle one or Shift + right.
+    this.orbit.mouseButtons = { LEFT: null, MIDDLE: THREE.MOUSE.PAN, RIGHT: THREE.MOUSE.ROTATE };
     this.orbit.addEventListener('change', () => this.requestRender());
     this.gizmo = new TransformControls(this.camera, this.renderer.domElement);
     this.gizmo.addEventListener('change', () => this.requestRender());
     this.gizmo.addEventListener('dragging-changed', (e) => (this.orbit.enabled = !e.value));
     this.scene.add(this.gizmo.getHelper());
+    container.addEventListener('contextmenu', (e) => e.preventDefault());
 
     new ResizeObserver(() => this.resize()).observe(container);
     this.resize();
@@ -65,23 +84,30 @@ export class Viewer {
     return this.renderer.domElement;
   }
 
-  setMesh(positions: Float32Array, indices: Uint32Array): void {
+  // A new mesh; `keepCamera` for another pose of the same one.
+  setMesh(positions: Float32Array, indices: Uint32Array, keepCamera: boolean): void {
     const n = positions.length / 3;
     this.geometry.setIndex(new THREE.BufferAttribute(indices.slice(), 1));
     this.geometry.setAttribute('position', new THREE.BufferAttribute(positions.slice(), 3));
-    this.geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
+    const colors = this.geometry.getAttribute('color');
+    if (!colors || colors.count !== n) {
+      this.geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
+    }
     this.geometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
-    this.updateNormals();
     this.geometry.computeBoundingSphere();
-    const sphere = this.geometry.boundingSphere!;
-    const distance = sphere.radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2));
-    this.camera.near = sphere.radius / 100;
-    this.camera.far = sphere.radius * 100;
-    this.camera.position.copy(sphere.center).add(new THREE.Vector3(0.25, 0.35, 1).normalize().multiplyScalar(1.05 * distance));
-    this.camera.updateProjectionMatrix();
-    this.orbit.target.copy(sphere.center);
-    this.orbit.update();
-    this.gizmo.setSize(0.9);
+    this.bvh = new MeshBVH(this.geometry);
+    this.bvhStale = false;
+    this.coarse.visible = false;
+    this.surface.visible = true;
+    if (!keepCamera) {
+      const sphere = this.geometry.boundingSphere!;
+      this.camera.near = sphere.radius / 100;
+      this.camera.far = sphere.radius * 100;
+      this.camera.updateProjectionMatrix();
+      this.frameSphere(sphere);
+      this.home = { position: this.camera.position.clone(), target: this.orbit.target.clone() };
+      this.gizmo.setSize(0.8);
+    }
     this.requestRender();
   }
 
@@ -89,27 +115,88 @@ export class Viewer {
     return this.geometry.getAttribute('position').array as Float32Array;
   }
 
-  setPositions(positions: Float32Array): void {
-    const attribute = this.geometry.getAttribute('position') as THREE.BufferAttribute;
-    (attribute.array as Float32Array).set(positions);
-    attribute.needsUpdate = true;
-    this.updateNormals();
-    this.boundsStale = true;
+  // A full frame: positions and their normals (computed off the main thread).
+  setPositions(positions: Float32Array, normals: Float32Array): void {
+    const p = this.geometry.getAttribute('position') as THREE.BufferAttribute;
+    (p.array as Float32Array).set(positions);
+    p.needsUpdate = true;
+    const nrm = this.geometry.getAttribute('normal') as THREE.BufferAttribute;
+    (nrm.array as Float32Array).set(normals);
+    nrm.needsUpdate = true;
+    this.bvhStale = true;
+    this.coarse.visible = false;
+    this.surface.visible = true;
     this.requestRender();
   }
 
-  private updateNormals(): void {
-    const normals = this.geometry.getAttribute('normal') as THREE.BufferAttribute;
-    vertexNormals(this.positions(), this.geometry.index!.array as Uint32Array, normals.array as Float32Array);
-    normals.needsUpdate = true;
-  }
-
-  // colours: 3 floats per vertex.
-  setColors(colors: Float32Array): void {
+  // Colours (3 floats per vertex) of the vertices listed, or of all.
+  setColors(colors: Float32Array, vertices?: ArrayLike<number>): void {
     const attribute = this.geometry.getAttribute('color') as THREE.BufferAttribute;
-    (attribute.array as Float32Array).set(colors);
+    const array = attribute.array as Float32Array;
+    if (!vertices) {
+      array.set(colors);
+      attribute.clearUpdateRanges();
+    } else {
+      let lo = Infinity, hi = -1;
+      for (let i = 0; i < vertices.length; ++i) {
+        const v = vertices[i];
+        array[3 * v] = colors[3 * v];
+        array[3 * v + 1] = colors[3 * v + 1];
+        array[3 * v + 2] = colors[3 * v + 2];
+        lo = Math.min(lo, v);
+        hi = Math.max(hi, v);
+      }
+      if (hi < 0) return;
+      attribute.clearUpdateRanges();
+      attribute.addUpdateRange(3 * lo, 3 * (hi - lo + 1)); // only the changed span is uploaded
+    }
     attribute.needsUpdate = true;
+    this.syncCoarseColors();
     this.requestRender();
+  }
+
+  // The coarse mesh of drags: some mesh vertices and triangles between them.
+  setPreview(vertices: Uint32Array, indices: Uint32Array): void {
+    this.coarseVertices = vertices.slice();
+    const k = vertices.length;
+    this.coarseGeometry.setIndex(new THREE.BufferAttribute(indices.slice(), 1));
+    this.coarseGeometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * k), 3));
+    this.coarseGeometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(3 * k), 3));
+    this.coarseGeometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * k), 3));
+    this.syncCoarseColors();
+  }
+
+  get previewSize(): number {
+    return this.coarseVertices.length;
+  }
+
+  showPreview(positions: Float32Array, normals: Float32Array): void {
+    const p = this.coarseGeometry.getAttribute('position') as THREE.BufferAttribute;
+    const nrm = this.coarseGeometry.getAttribute('normal') as THREE.BufferAttribute;
+    if (!p || p.count * 3 !== positions.length) return;
+    (p.array as Float32Array).set(positions);
+    (nrm.array as Float32Array).set(normals);
+    p.needsUpdate = nrm.needsUpdate = true;
+    this.coarse.visible = true;
+    this.surface.visible = false;
+    this.requestRender();
+  }
+
+  get showingPreview(): boolean {
+    return this.coarse.visible;
+  }
+
+  private syncCoarseColors(): void {
+    const target = this.coarseGeometry.getAttribute('color') as THREE.BufferAttribute | undefined;
+    if (!target) return;
+    const source = this.geometry.getAttribute('color').array as Float32Array;
+    const out = target.array as Float32Array;
+    this.coarseVertices.forEach((v, i) => {
+      out[3 * i] = source[3 * v];
+      out[3 * i + 1] = source[3 * v + 1];
+      out[3 * i + 2] = source[3 * v + 2];
+    });
+    target.needsUpdate = true;
   }
 
   setWireframe(on: boolean): void {
@@ -117,18 +204,25 @@ export class Viewer {
     this.requestRender();
   }
 
-  pick(clientX: number, clientY: number): Hit | null {
-    const rect = this.canvas.getBoundingClientRect();
-    const ndc = new THREE.Vector2(
-      ((clientX - rect.left) / rect.width) * 2 - 1,
-      -((clientY - rect.top) / rect.height) * 2 + 1,
-    );
-    this.raycaster.setFromCamera(ndc, this.camera);
-    if (this.boundsStale) {
-      this.geometry.computeBoundingSphere();
-      this.boundsStale = false;
+  // The brush's circle, on the surface's tangent plane at `hit`; null hides it.
+  showBrush(hit: Hit | null, radius: number): void {
+    this.ring.visible = hit !== null;
+    if (hit) {
+      this.ring.position.copy(hit.point);
+      this.ring.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1), hit.normal);
+      this.ring.scale.setScalar(radius);
     }
-    const hit = this.raycaster.intersectObject(this.surface, false)[0];
+    this.requestRender();
+  }
+
+  pick(clientX: number, clientY: number): Hit | null {
+    if (!this.bvh) return null;
+    if (this.bvhStale) {
+      this.bvh.refit();
+      this.bvhStale = false;
+    }
+    this.raycaster.setFromCamera(this.ndc(clientX, clientY), this.camera);
+    const hit = this.bvh.raycastFirst(this.raycaster.ray, THREE.DoubleSide);
     if (!hit || !hit.face) return null;
     const p = this.positions();
     let best = hit.face.a;
@@ -137,7 +231,9 @@ export class Viewer {
       const d = hit.point.distanceToSquared(new THREE.Vector3(p[3 * v], p[3 * v + 1], p[3 * v + 2]));
       if (d < bestDistance) [best, bestDistance] = [v, d];
     }
-    return { point: hit.point.clone(), vertex: best };
+    const normal = hit.face.normal.clone();
+    if (normal.dot(this.raycaster.ray.direction) > 0) normal.negate();
+    return { point: hit.point.clone(), normal, vertex: best };
   }
 
   // A world point's position in client (CSS pixel) coordinates.
@@ -149,15 +245,55 @@ export class Viewer {
 
   // The world point under (clientX, clientY) on the plane through `through` facing the camera.
   onViewPlane(clientX: number, clientY: number, through: THREE.Vector3): THREE.Vector3 | null {
-    const rect = this.canvas.getBoundingClientRect();
-    const ndc = new THREE.Vector2(
-      ((clientX - rect.left) / rect.width) * 2 - 1,
-      -((clientY - rect.top) / rect.height) * 2 + 1,
-    );
-    this.raycaster.setFromCamera(ndc, this.camera);
+    this.raycaster.setFromCamera(this.ndc(clientX, clientY), this.camera);
     const normal = this.camera.getWorldDirection(new THREE.Vector3());
     const plane = new THREE.Plane().setFromNormalAndCoplanarPoint(normal, through);
     return this.raycaster.ray.intersectPlane(plane, new THREE.Vector3());
+  }
+
+  // Frames the given points (or the whole mesh) without turning the camera.
+  frame(points?: THREE.Vector3[]): void {
+    const sphere = points && points.length > 0
+      ? new THREE.Sphere().setFromPoints(points)
+      : this.geometry.boundingSphere ?? new THREE.Sphere();
+    sphere.radius = Math.max(sphere.radius, (this.geometry.boundingSphere?.radius ?? 1) * 0.05);
+    this.frameSphere(sphere, this.camera.position.clone().sub(this.orbit.target));
+  }
+
+  resetCamera(): void {
+    this.camera.position.copy(this.home.position);
+    this.orbit.target.copy(this.home.target);
+    this.orbit.update();
+    this.requestRender();
+  }
+
+  private frameSphere(sphere: THREE.Sphere, direction = new THREE.Vector3(0.25, 0.35, 1)): void {
+    const distance = sphere.radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2));
+    this.camera.position.copy(sphere.center).add(direction.normalize().multiplyScalar(1.05 * distance));
+    this.orbit.target.copy(sphere.center);
+    this.orbit.update();
+    this.requestRender();
+  }
+
+  // Milliseconds to draw the full mesh once, waited for (gl.finish): what decides whether drags
+  // show the preview.
+  measureDraw(): number {
+    const gl = this.renderer.getContext();
+    const coarse = this.coarse.visible;
+    this.coarse.visible = false;
+    this.surface.visible = true;
+    this.renderer.render(this.scene, this.camera);
+    gl.finish();
+    const times: number[] = [];
+    for (let i = 0; i < 3; ++i) {
+      const t = performance.now();
+      this.renderer.render(this.scene, this.camera);
+      gl.finish();
+      times.push(performance.now() - t);
+    }
+    this.coarse.visible = coarse;
+    this.surface.visible = !coarse;
+    return times.sort((a, b) => a - b)[1];
   }
 
   requestRender(): void {
@@ -168,6 +304,11 @@ export class Viewer {
       this.renderer.render(this.scene, this.camera);
       this.onRendered();
     });
+  }
+
+  private ndc(clientX: number, clientY: number): THREE.Vector2 {
+    const rect = this.canvas.getBoundingClientRect();
+    return new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
   }
 
   private resize(): void {

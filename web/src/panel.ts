@@ -1,0 +1,382 @@
+// The side panel and what is drawn over the viewport: status, the next step, counts, messages
+// (errors stay until dismissed) and their log, the disconnected banner, progress with Cancel,
+// and the confirmation before a mesh replaces unsaved work. Everything shown follows from the
+// state (render()); the controls send requests through it.
+import { Interaction, Tool } from './interaction';
+import * as P from './protocol';
+import { EditorState, FIXED_HEX, GROUP_HEX, PIN_HEX, stats } from './state';
+
+const $ = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
+
+const HINTS: Record<Tool, string> = {
+  handle: 'Handle: paint the part to move with the left button.',
+  fixed: 'Fixed: paint what must stay at its rest position.',
+  pin: 'Pin: paint what must stay where it is shown now (each stroke is one pin).',
+  erase: 'Erase: paint to clear handles, fixed vertices and pins.',
+  move: 'Move: drag a coloured handle, or the gizmo beside it (T translate, R rotate); Esc cancels.',
+};
+
+export class Panel {
+  private shownNotes = 0; // notes already turned into toasts
+  private lastPhase = '';
+
+  constructor(private readonly s: EditorState, private readonly ui: Interaction) {
+    s.subscribe(() => this.render());
+    ui.onToolChange = () => this.render();
+    this.bind();
+    setInterval(() => this.renderTimings(), 500);
+    setInterval(() => this.renderBanner(), 250);
+  }
+
+  // Asks before replacing an edit that would be lost; resolves true to go on.
+  confirmDiscard(action: string): Promise<boolean> {
+    const c = this.s.counts();
+    if (c.handles + c.fixed + c.pinned === 0 && !this.s.server?.undo) return Promise.resolve(true);
+    const dialog = $<HTMLDialogElement>('confirm');
+    $('confirm-text').textContent = `${action} replaces the current edit (${c.handles.toLocaleString()} handle, ` +
+      `${c.fixed.toLocaleString()} fixed and ${c.pinned.toLocaleString()} pinned vertices, and its undo history). ` +
+      'Export the scene first to keep it.';
+    dialog.showModal();
+    return new Promise((resolve) => {
+      const done = (answer: boolean) => {
+        dialog.close();
+        $('confirm-yes').onclick = $('confirm-no').onclick = null;
+        resolve(answer);
+      };
+      $('confirm-yes').onclick = () => done(true);
+      $('confirm-no').onclick = () => done(false);
+      dialog.oncancel = () => done(false);
+    });
+  }
+
+  private bind(): void {
+    const s = this.s;
+    document.querySelectorAll<HTMLButtonElement>('[data-tool]').forEach((b) =>
+      b.addEventListener('click', () => this.ui.setTool(b.dataset.tool as Tool)),
+    );
+    $('reconnect').addEventListener('click', () => s.connect());
+    $('cancel').addEventListener('click', () => {
+      s.connection.send({ type: 'cancel' });
+      $('cancel').textContent = 'Cancelling…';
+    });
+    $('open-demo').addEventListener('click', async () => {
+      if (await this.confirmDiscard('Opening the demo')) s.request({ type: 'open_demo' }, 'open the demo', 'state');
+    });
+    const fileInput = (id: string, tag: P.FileTag, what: string, confirm: string | null) => {
+      $<HTMLInputElement>(id).addEventListener('change', async (e) => {
+        const input = e.target as HTMLInputElement;
+        const f = input.files?.[0];
+        input.value = '';
+        if (f) await this.openFile(f, tag, what, confirm);
+      });
+    };
+    fileInput('open-mesh', P.Tag.MeshFile, 'open mesh', 'Opening another mesh');
+    fileInput('open-selection', P.Tag.SelectionFile, 'load selection', 'Loading a selection');
+    fileInput('open-scene', P.Tag.SceneFile, 'open scene', 'Opening a scene');
+    $('wireframe').addEventListener('change', (e) => s.viewer.setWireframe((e.target as HTMLInputElement).checked));
+    $('show-base').addEventListener('change', (e) =>
+      s.request({ type: 'settings', view: (e.target as HTMLInputElement).checked ? 'base' : 'detailed' }, 'view', 'ready'));
+    // Fields: Enter applies and leaves the field (so that shortcuts work again), Escape puts the
+    // server's value back. m is applied with its button: a new basis costs seconds.
+    for (const id of ['ks', 'kb']) {
+      $(id).addEventListener('change', (e) => {
+        const v = Number((e.target as HTMLInputElement).value);
+        if (Number.isFinite(v)) s.request({ type: 'settings', [id]: v }, 'settings', 'ready');
+      });
+    }
+    for (const id of ['energy', 'detail', 'constraints']) {
+      $(id).addEventListener('change', (e) =>
+        s.request({ type: 'settings', [id]: (e.target as HTMLSelectElement).value } as P.ClientText, 'settings', 'ready'));
+    }
+    $('modes').addEventListener('input', () => this.renderModes());
+    $('apply-modes').addEventListener('click', () => {
+      const m = Number($<HTMLInputElement>('modes').value);
+      s.request({ type: 'settings', modes: m }, `basis with m = ${m}`, 'ready');
+    });
+    for (const field of document.querySelectorAll<HTMLInputElement | HTMLSelectElement>('#panel input, #panel select')) {
+      field.addEventListener('keydown', (e) => {
+        const k = (e as KeyboardEvent).key;
+        if (k === 'Enter') {
+          if (field.id === 'modes') $('apply-modes').click();
+          field.blur();
+        } else if (k === 'Escape') {
+          this.renderFields();
+          field.blur();
+        }
+      });
+    }
+    $('group').addEventListener('change', (e) => {
+      s.activeGroup = Number((e.target as HTMLSelectElement).value);
+      this.ui.placeGizmo();
+      this.render();
+    });
+    $('new-group').addEventListener('click', () => {
+      this.ui.newGroup(false);
+      this.ui.setTool('handle');
+    });
+    $('radius').addEventListener('input', () => this.render());
+    $('gizmo-translate').addEventListener('click', () => s.viewer.gizmo.setMode('translate'));
+    $('gizmo-rotate').addEventListener('click', () => s.viewer.gizmo.setMode('rotate'));
+    $('clear').addEventListener('click', () => {
+      s.labels.fill(0);
+      s.groups = [{ transform: s.groups[0].transform.identity(), pinned: false }];
+      s.activeGroup = 0;
+      s.paint();
+      s.sendSelection();
+      this.ui.placeGizmo();
+    });
+    $('undo').addEventListener('click', () => this.undo(false));
+    $('redo').addEventListener('click', () => this.undo(true));
+    $('reset').addEventListener('click', () => {
+      for (const g of s.groups) if (!g.pinned) g.transform.identity();
+      s.sendFrame(false);
+      s.connection.send({ type: 'commit' });
+      this.ui.placeGizmo();
+    });
+    $('apply-pose').addEventListener('click', () => s.request({ type: 'apply_pose' }, 'apply pose', 'state'));
+    $('export-mesh').addEventListener('click', () =>
+      s.request({ type: 'export_mesh', format: $<HTMLSelectElement>('export-format').value as 'obj' }, 'export mesh', 'file'));
+    $('export-scene').addEventListener('click', () => s.request({ type: 'export_scene' }, 'export scene', 'file'));
+
+    window.addEventListener('keydown', (e) => this.key(e));
+    window.addEventListener('dragover', (e) => {
+      e.preventDefault();
+      document.body.classList.add('drop');
+    });
+    window.addEventListener('dragleave', () => document.body.classList.remove('drop'));
+    window.addEventListener('drop', (e) => {
+      e.preventDefault();
+      document.body.classList.remove('drop');
+      const f = e.dataTransfer?.files[0];
+      if (!f) return;
+      if (/\.(sel|dmat)$/i.test(f.name)) this.openFile(f, P.Tag.SelectionFile, 'load selection', 'Loading a selection');
+      else if (/\.json$/i.test(f.name)) this.openFile(f, P.Tag.SceneFile, 'open scene', 'Opening a scene');
+      else this.openFile(f, P.Tag.MeshFile, 'open mesh', 'Opening another mesh');
+    });
+  }
+
+  private async openFile(f: File, tag: P.FileTag, what: string, confirm: string | null): Promise<void> {
+    if (confirm && !(await this.confirmDiscard(confirm))) return;
+    this.s.note(`sending ${f.name} (${(f.size / 1e6).toFixed(1)} MB)…`);
+    this.s.request(P.encodeFile(tag, f.name, await f.arrayBuffer()), `${what} ${f.name}`, 'state');
+  }
+
+  private undo(redo: boolean): void {
+    const s = this.s;
+    if (!s.editable) return;
+    if (!(redo ? s.server?.redo : s.server?.undo)) return s.note(redo ? 'nothing to redo' : 'nothing to undo');
+    s.request({ type: redo ? 'redo' : 'undo' }, redo ? 'redo' : 'undo', 'state');
+  }
+
+  private key(e: KeyboardEvent): void {
+    const target = e.target as HTMLElement;
+    if (target instanceof HTMLInputElement || target instanceof HTMLSelectElement || target instanceof HTMLTextAreaElement) return;
+    if ($<HTMLDialogElement>('confirm').open) return;
+    const key = e.key.toLowerCase();
+    const s = this.s;
+    if ((e.ctrlKey || e.metaKey) && key === 'z') {
+      e.preventDefault();
+      this.undo(e.shiftKey);
+    } else if ((e.ctrlKey || e.metaKey) && key === 'y') {
+      e.preventDefault();
+      this.undo(true);
+    } else if (e.key === 'Escape') {
+      this.ui.cancel();
+    } else if (e.key === 'Home') {
+      s.viewer.resetCamera();
+    } else if (!e.ctrlKey && !e.metaKey && !e.altKey) {
+      const tools: Record<string, Tool> = { '1': 'handle', '2': 'fixed', '3': 'erase', '4': 'move', '5': 'pin' };
+      if (tools[key]) this.ui.setTool(tools[key]);
+      else if (key === 'n') $('new-group').click();
+      else if (key === 't') s.viewer.gizmo.setMode('translate');
+      else if (key === 'r') s.viewer.gizmo.setMode('rotate');
+      else if (key === 'f') this.ui.frameSelection();
+    }
+  }
+
+  // ------------------------------------------------------------ rendering
+
+  private render(): void {
+    const s = this.s;
+    const phase = s.phase;
+    const connected = s.connection.open;
+    const editable = s.editable;
+    const r = s.ready;
+
+    // Status, over the viewport.
+    const status = $('status');
+    const [text, cls] = (() => {
+      switch (phase.kind) {
+        case 'connecting': return ['Connecting to the server…', 'busy'];
+        case 'disconnected': return ['Disconnected — edits are paused', 'down'];
+        case 'empty': return ['No mesh is open: open one (Open mesh…, or drop a file) or the Demo', 'busy'];
+        case 'loading': return [`${phase.stage}… ${Math.round(100 * phase.fraction)}%`, 'busy'];
+        case 'busy': return [`${phase.what}: waiting for the server…`, 'busy'];
+        case 'ready': return [r ? `${r.name}: ready` : 'ready', 'ready'];
+      }
+    })();
+    status.textContent = text;
+    status.className = cls;
+    $('hint').textContent = editable ? this.nextStep() : '';
+    const c = s.counts();
+    $('counts').textContent = r && editable
+      ? `handles: ${c.handles.toLocaleString()} vertices in ${c.groups} group${c.groups === 1 ? '' : 's'} · ` +
+        `fixed: ${c.fixed.toLocaleString()} · pinned: ${c.pinned.toLocaleString()}` +
+        (s.server?.held_pieces ? ` · ${s.server.held_pieces} piece(s) without handles held in place` : '')
+      : '';
+    this.renderNotes();
+
+    // Progress with Cancel.
+    const loading = phase.kind === 'loading';
+    $('progress').hidden = !loading;
+    if (loading) {
+      $('progress-stage').textContent = `${phase.stage}… ${Math.round(100 * phase.fraction)}%`;
+      $<HTMLProgressElement>('progress-bar').value = phase.fraction;
+      $<HTMLButtonElement>('cancel').hidden = !phase.cancellable;
+    } else {
+      $('cancel').textContent = 'Cancel';
+    }
+
+    // The panel: what can be done now.
+    $('mesh-name').textContent = r
+      ? `${r.name}: ${r.vertices.toLocaleString()} vertices, ${r.faces.toLocaleString()} triangles`
+      : phase.kind === 'empty' ? 'no mesh open' : 'connecting…';
+    const enable = (id: string, on: boolean) => ($<HTMLButtonElement>(id).disabled = !on);
+    for (const id of ['undo', 'redo', 'reset', 'apply-pose', 'export-mesh', 'export-scene', 'clear', 'new-group',
+      'energy', 'ks', 'kb', 'detail', 'constraints', 'modes', 'show-base', 'group', 'export-format']) {
+      enable(id, editable);
+    }
+    enable('open-demo', connected && phase.kind !== 'loading' && phase.kind !== 'busy');
+    document.querySelectorAll<HTMLLabelElement>('label.button').forEach((l) => {
+      const input = l.querySelector('input')!;
+      const on = connected && (phase.kind === 'ready' || (phase.kind === 'empty' && input.id === 'open-mesh'));
+      input.disabled = !on;
+      l.classList.toggle('disabled', !on);
+    });
+    enable('undo', editable && !!s.server?.undo);
+    enable('redo', editable && !!s.server?.redo);
+    enable('export-scene', editable && (r?.pose ?? 0) === 0 && s.hasHandles());
+    enable('apply-pose', editable && s.hasHandles());
+    $('pose').textContent = r && r.pose > 0 ? `pose ${r.pose} applied` : '';
+    document.querySelectorAll<HTMLButtonElement>('[data-tool]').forEach((b) => {
+      b.setAttribute('aria-checked', String(b.dataset.tool === this.ui.tool));
+      b.disabled = !editable;
+    });
+    const select = $<HTMLSelectElement>('group');
+    const groups = s.groups.map((g, k) => ({ g, k })).filter(({ g }) => !g.pinned);
+    select.replaceChildren(...groups.map(({ k }) => new Option(`${k + 1}`, `${k}`, false, k === s.activeGroup)));
+    const active = s.groups[s.activeGroup];
+    select.style.color = `#${(active?.pinned ? PIN_HEX : GROUP_HEX[s.activeGroup % GROUP_HEX.length]).toString(16).padStart(6, '0')}`;
+    $('radius-value').textContent = `${$<HTMLInputElement>('radius').value}% of the diagonal`;
+    if (phase.kind !== this.lastPhase && (phase.kind === 'ready' || phase.kind === 'empty')) this.renderFields();
+    this.lastPhase = phase.kind;
+    if (!connected || !editable) s.viewer.gizmo.detach();
+    else if (this.ui.tool === 'move' && !s.viewer.gizmo.object) this.ui.placeGizmo();
+    void FIXED_HEX;
+  }
+
+  // What to do next, from what is selected.
+  private nextStep(): string {
+    const c = this.s.counts();
+    const tool = HINTS[this.ui.tool];
+    if (c.handles === 0) return `${tool} Next: paint a handle (1), paint what must stay (2), then drag it (4).`;
+    if (c.fixed + c.pinned === 0) return `${tool} Next: paint what must stay (Fixed, 2), or drag now (Move, 4).`;
+    if (this.ui.tool !== 'move') return `${tool} Next: drag the handle (Move, 4).`;
+    return `${tool} Then: Export, or Apply pose to edit from this shape.`;
+  }
+
+  // Fields show the server's values (after every "ready", and after a rejected change).
+  private renderFields(): void {
+    const r = this.s.ready;
+    if (!r) return;
+    $<HTMLInputElement>('modes').value = String(r.modes);
+    $<HTMLSelectElement>('energy').value = r.settings.energy;
+    $<HTMLInputElement>('ks').value = String(r.settings.ks);
+    $<HTMLInputElement>('kb').value = String(r.settings.kb);
+    $<HTMLSelectElement>('detail').value = r.settings.detail;
+    $<HTMLSelectElement>('constraints').value = r.settings.constraints;
+    $<HTMLInputElement>('show-base').checked = r.settings.view === 'base';
+    this.renderModes();
+  }
+
+  // The Apply button of m, with what a new basis would cost.
+  private renderModes(): void {
+    const r = this.s.ready;
+    const m = Number($<HTMLInputElement>('modes').value);
+    const changed = r !== null && Number.isInteger(m) && m >= 1 && m !== r.modes;
+    $<HTMLButtonElement>('apply-modes').disabled = !changed || !this.s.editable;
+    let cost = '';
+    if (changed && r) {
+      cost = r.basis.source === 'computed'
+        ? `about ${Math.max(0.1, (r.basis.seconds * m) / r.modes).toFixed(1)} s to compute (m = ${r.modes} took ${r.basis.seconds.toFixed(1)} s); Cancel stops it`
+        : `a new basis of ${r.vertices.toLocaleString()} vertices (seconds to minutes); Cancel stops it`;
+    }
+    $('modes-cost').textContent = cost;
+  }
+
+  private renderNotes(): void {
+    const s = this.s;
+    const notes = $('notes');
+    for (; this.shownNotes < s.notes.length; ++this.shownNotes) {
+      const note = s.notes[this.shownNotes];
+      const el = document.createElement('div');
+      el.className = `note ${note.level}`;
+      el.setAttribute('role', note.level === 'error' ? 'alert' : 'status');
+      const text = document.createElement('span');
+      text.textContent = note.text;
+      const close = document.createElement('button');
+      close.textContent = '×';
+      close.title = 'dismiss';
+      close.onclick = () => el.remove();
+      el.append(text, close);
+      notes.append(el);
+      // Information fades; errors stay until dismissed.
+      if (note.level === 'info') setTimeout(() => el.remove(), 6000);
+      while (notes.children.length > 4) notes.firstElementChild!.remove();
+      const li = document.createElement('li');
+      li.className = note.level;
+      li.textContent = `${new Date(note.time).toLocaleTimeString()} ${note.text}`;
+      $('log').append(li);
+      while ($('log').children.length > 30) $('log').firstElementChild!.remove();
+    }
+    if (s.notes.length < this.shownNotes) this.shownNotes = s.notes.length;
+  }
+
+  private renderBanner(): void {
+    const phase = this.s.phase;
+    const banner = $('banner');
+    banner.hidden = phase.kind !== 'disconnected';
+    if (phase.kind !== 'disconnected') return;
+    const wait = phase.retryAt === null ? null : Math.max(0, Math.ceil((phase.retryAt - performance.now()) / 1000));
+    $('banner-text').textContent = `Disconnected: ${phase.reason}. ` +
+      (wait === null ? 'Edits are paused.' : `Reconnecting in ${wait} s; edits are paused.`);
+  }
+
+  private renderTimings(): void {
+    const s = this.s;
+    const r = s.ready;
+    const f = s.frame;
+    const now = performance.now();
+    const lastSecond = stats.drawTimes.filter((t) => now - t < 1000).length;
+    const median = (v: number[]) => (v.length ? [...v].sort((a, b) => a - b)[Math.floor(v.length / 2)] : NaN);
+    const rows: [string, string][] = [
+      ['basis', r ? `${r.basis.seconds.toFixed(2)} s (${r.basis.source}, m = ${r.modes})` : '–'],
+      ['selection', s.server ? `${(1000 * s.server.selection_seconds).toFixed(1)} ms` : '–'],
+      ['solve (server)', f ? `${f.ms.total.toFixed(1)} ms` : '–'],
+      ['· reduced / inverse / detail', f
+        ? `${f.ms.reducedSolve.toFixed(1)} / ${f.ms.inverseTransform.toFixed(1)} / ${f.ms.detail.toFixed(1)}` : '–'],
+      ['ARAP iterations', r?.settings.energy === 'arap' && f
+        ? `${f.arap.iterations}${f.arap.converged ? '' : ' (not converged)'} · ${r.arap_clusters} clusters` : '–'],
+      ['drag → drawn (median)', stats.latencies.length ? `${median(stats.latencies.slice(-30)).toFixed(0)} ms` : '–'],
+      ['updates drawn per second', `${lastSecond}`],
+      ['full draw / preview', s.drawMs ? `${s.drawMs.toFixed(0)} ms / ${s.previewWanted ? `${s.viewer.previewSize.toLocaleString()} vertices` : 'off'}` : '–'],
+      ['handle error / diagonal', f ? f.error.max.toExponential(1) : '–'],
+    ];
+    $('timings').replaceChildren(...rows.map(([k, v]) => {
+      const tr = document.createElement('tr');
+      tr.append(Object.assign(document.createElement('td'), { textContent: k }),
+        Object.assign(document.createElement('td'), { textContent: v }));
+      return tr;
+    }));
+  }
+}

@@ -1,0 +1,460 @@
+// The editor's state: the mesh as the server has it, the selection (a label per vertex) with
+// the handle groups' transforms, and one explicit phase. Server messages come in here and
+// nowhere else; what the page shows follows from this state (panel.ts) and the view.
+import * as THREE from 'three';
+import { Connection, ConnectionStatus } from './connection';
+import type { Slot, WorkerReply, WorkerRequest } from './geometry.worker';
+import * as P from './protocol';
+import { Viewer } from './viewer';
+
+// Per-vertex labels: 0 free, 1 fixed, 2 + g handle group g.
+export const FREE = 0;
+export const FIXED = 1;
+
+export type Phase =
+  | { kind: 'connecting' }
+  | { kind: 'disconnected'; reason: string; retryAt: number | null }
+  | { kind: 'empty' } // connected, no mesh open: open one or the demo
+  | { kind: 'loading'; stage: string; fraction: number; cancellable: boolean }
+  | { kind: 'busy'; what: string; expects: 'ready' | 'state' | 'file' }
+  | { kind: 'ready' };
+
+export interface Group {
+  transform: THREE.Matrix4; // acting on rest positions
+  pinned: boolean;
+}
+
+export type Note = { text: string; level: 'info' | 'error'; time: number };
+
+// Drawing and response statistics (the timings panel and the end-to-end test).
+export const stats = {
+  framesDrawn: 0,
+  framesReceived: 0,
+  previewsDrawn: 0,
+  latencies: [] as number[], // mouse event to its frame drawn (ms)
+  receiveLatencies: [] as number[], // to its result received
+  drawTimes: [] as number[],
+};
+
+// Draws slower than this (ms, measured once per mesh) make drags show the preview mesh, sized
+// to draw in about kPreviewMs.
+const kFullDrawBudgetMs = 25;
+const kPreviewMs = 8;
+
+export class EditorState {
+  phase: Phase = { kind: 'connecting' };
+  readonly connection: Connection;
+  ready: P.ReadyMessage | null = null;
+  server: P.StateMessage | null = null;
+  rest = new Float32Array(0);
+  indices = new Uint32Array(0);
+  labels = new Int16Array(0);
+  groups: Group[] = [{ transform: new THREE.Matrix4(), pinned: false }];
+  activeGroup = 0;
+  frame: P.FrameResult | null = null; // the last one received
+  notes: Note[] = [];
+  drawMs = 0; // the full mesh's draw time
+  previewWanted = false;
+  painting = false; // a brush stroke is on (interaction.ts)
+  discardFrames = false; // count frame results without drawing them (measuring the server)
+  private listeners: (() => void)[] = [];
+  private seq = 0;
+  private sentAt = new Map<number, number>();
+  private pendingDraw: number | null = null;
+  private outstanding: number | null = null; // the last frame sent, until a result as new arrives
+  private lastDrawn = 0;
+  private worker = new Worker(new URL('./geometry.worker.ts', import.meta.url), { type: 'module' });
+  private normalsBusy: Record<Slot, boolean> = { full: false, preview: false };
+  private normalsQueued: Record<Slot, P.FrameResult | null> = { full: null, preview: null };
+  private brushId = 0;
+  private brushReplies = new Map<number, (vertices: Uint32Array) => void>();
+  private wasOpen = false;
+  private restoreChecked = true;
+  private restoring = false; // the server sent an empty selection where this page has one
+  private restoreSettings: P.ClientText | null = null;
+  private pendingSelections = 0;
+
+  constructor(readonly viewer: Viewer) {
+    this.connection = new Connection(`ws://${location.host}/ws`, {
+      status: (s) => this.onStatus(s),
+      text: (m) => this.onText(m),
+      binary: (b) => this.onBinary(b),
+    });
+    this.worker.onmessage = (e: MessageEvent<WorkerReply>) => this.onWorker(e.data);
+    viewer.onRendered = () => this.onRendered();
+  }
+
+  subscribe(listener: () => void): void {
+    this.listeners.push(listener);
+  }
+
+  changed(): void {
+    for (const l of this.listeners) l();
+  }
+
+  get editable(): boolean {
+    return this.phase.kind === 'ready';
+  }
+
+  // Messages for the user: errors stay until dismissed (panel.ts), the last 30 are kept.
+  note(text: string, level: Note['level'] = 'info'): void {
+    if (!text) return;
+    this.notes.push({ text, level, time: Date.now() });
+    if (this.notes.length > 30) this.notes.shift();
+    this.changed();
+  }
+
+  // ------------------------------------------------------------ requests
+
+  // A request whose reply ends the busy phase: "ready" (settings), "state" (edits, a mesh, a
+  // pose) or "file" (exports); an error always ends it.
+  request(message: P.ClientText | ArrayBuffer, what: string, expects: 'ready' | 'state' | 'file'): boolean {
+    if (!this.connection.open) {
+      this.note(`${what}: not connected to the server`, 'error');
+      return false;
+    }
+    this.connection.send(message);
+    this.phase = { kind: 'busy', what, expects };
+    this.changed();
+    return true;
+  }
+
+  sendSelection(fit: Set<number> = new Set()): void {
+    const s: P.Selection = {
+      groups: this.groups.map((g, k) => ({
+        vertices: new Uint32Array(0),
+        transform: rowMajor(g.transform),
+        pinned: g.pinned,
+        fit: fit.has(k),
+      })),
+      fixed: new Uint32Array(0),
+    };
+    const lists: number[][] = this.groups.map(() => []);
+    const fixed: number[] = [];
+    this.labels.forEach((l, v) => {
+      if (l === FIXED) fixed.push(v);
+      else if (l >= 2) lists[l - 2].push(v);
+    });
+    s.groups.forEach((g, k) => (g.vertices = Uint32Array.from(lists[k])));
+    s.fixed = Uint32Array.from(fixed);
+    if (this.connection.send(P.encodeSelection(s))) ++this.pendingSelections;
+    else this.note('the selection was not sent: not connected (it is sent again on reconnection)', 'error');
+  }
+
+  // Sends the transforms as they are now; `preview`: answered with the preview's vertices.
+  sendFrame(preview = false): void {
+    if (!this.hasHandles()) return;
+    ++this.seq;
+    this.sentAt.set(this.seq, performance.now());
+    this.outstanding = this.seq;
+    this.connection.send(P.encodeFrame(this.seq, this.groups.map((g) => rowMajor(g.transform)), preview));
+  }
+
+  get lastSeq(): number {
+    return this.seq;
+  }
+
+  hasHandles(): boolean {
+    return this.labels.some((l) => l >= 2);
+  }
+
+  counts(): { handles: number; fixed: number; pinned: number; groups: number } {
+    let handles = 0, fixed = 0, pinned = 0;
+    const used = new Set<number>();
+    this.labels.forEach((l) => {
+      if (l === FIXED) ++fixed;
+      else if (l >= 2) {
+        used.add(l - 2);
+        if (this.groups[l - 2]?.pinned) ++pinned;
+        else ++handles;
+      }
+    });
+    return { handles, fixed, pinned, groups: [...used].filter((g) => !this.groups[g]?.pinned).length };
+  }
+
+  settled(): boolean {
+    return this.outstanding === null && this.pendingDraw === null && this.pendingSelections === 0 && !this.painting &&
+      !this.normalsBusy.full && this.phase.kind !== 'busy';
+  }
+
+  // The vertices a brush stroke reaches (computed by the worker).
+  brush(vertex: number, center: THREE.Vector3, radius: number, geodesic: boolean): Promise<Uint32Array> {
+    const id = ++this.brushId;
+    const request: WorkerRequest = { kind: 'brush', id, vertex, center: [center.x, center.y, center.z], radius, geodesic };
+    this.worker.postMessage(request);
+    return new Promise((resolve) => this.brushReplies.set(id, resolve));
+  }
+
+  // ------------------------------------------------------------ incoming
+
+  private onStatus(s: ConnectionStatus): void {
+    if (s.kind === 'open') {
+      this.phase = { kind: 'connecting' };
+      this.outstanding = null;
+      this.restoreChecked = !this.wasOpen; // after a reconnection: does the server still have the edit?
+      this.wasOpen = true;
+      this.connection.send({ type: 'hello' });
+    } else if (s.kind === 'closed') {
+      this.phase = { kind: 'disconnected', reason: s.reason, retryAt: s.retryAt };
+      this.pendingSelections = 0;
+      this.note(`disconnected: ${s.reason}`, 'error');
+    } else if (this.phase.kind !== 'disconnected') {
+      this.phase = { kind: 'connecting' };
+    }
+    this.changed();
+  }
+
+  private onText(m: P.ServerText): void {
+    switch (m.type) {
+      case 'progress':
+        this.phase = { kind: 'loading', stage: m.stage, fraction: m.fraction, cancellable: m.cancellable };
+        break;
+      case 'ready':
+        this.adoptReady(m);
+        if (this.phase.kind !== 'busy' || this.phase.expects === 'ready') this.phase = { kind: 'ready' };
+        break;
+      case 'state':
+        this.adoptState(m);
+        if (this.phase.kind !== 'busy' || this.phase.expects !== 'file') this.phase = { kind: 'ready' };
+        break;
+      case 'empty':
+        this.phase = { kind: 'empty' };
+        this.ready = null;
+        break;
+      case 'error':
+        if (m.request === 'selection') this.pendingSelections = Math.max(0, this.pendingSelections - 1);
+        this.note(m.cancelled ? m.message : `${requestName(m.request)}: ${m.message}`, m.cancelled ? 'info' : 'error');
+        this.phase = this.ready ? { kind: 'ready' } : { kind: 'empty' };
+        break;
+    }
+    this.changed();
+  }
+
+  private onBinary(buffer: ArrayBuffer): void {
+    switch (P.tagOf(buffer)) {
+      case P.Tag.Mesh:
+        return this.adoptMesh(P.decodeMesh(buffer));
+      case P.Tag.Preview: {
+        const p = P.decodePreview(buffer);
+        this.viewer.setPreview(p.vertices, p.indices);
+        this.post({ kind: 'mesh', slot: 'preview', indices: p.indices.slice(), vertices: p.vertices.length });
+        return;
+      }
+      case P.Tag.FrameResult: {
+        const r = P.decodeFrameResult(buffer);
+        const sent = this.sentAt.get(r.seq);
+        if (sent !== undefined) stats.receiveLatencies.push(performance.now() - sent);
+        stats.framesReceived++;
+        if (this.outstanding !== null && r.seq >= this.outstanding) this.outstanding = null;
+        if (this.discardFrames) return;
+        this.frame = r;
+        const slot: Slot = r.preview ? 'preview' : 'full';
+        if (this.normalsBusy[slot]) this.normalsQueued[slot] = r; // latest wins
+        else this.computeNormals(slot, r);
+        return;
+      }
+      case P.Tag.File: {
+        const f = P.decodeFile(buffer);
+        const a = document.createElement('a');
+        a.href = URL.createObjectURL(new Blob([f.data as BlobPart]));
+        a.download = f.name;
+        a.click();
+        setTimeout(() => URL.revokeObjectURL(a.href), 10000);
+        if (this.phase.kind === 'busy' && this.phase.expects === 'file') this.phase = { kind: 'ready' };
+        return this.note(`saved ${f.name}`);
+      }
+      case P.Tag.SelectionResult:
+        return this.adoptSelection(P.decodeSelection(buffer));
+    }
+  }
+
+  private computeNormals(slot: Slot, r: P.FrameResult): void {
+    this.normalsBusy[slot] = true;
+    // A copy goes to the worker and comes back with its normals (the message's buffer may hold
+    // other fields).
+    this.post({ kind: 'normals', slot, seq: r.seq, positions: r.positions.slice() }, true);
+  }
+
+  private onWorker(m: WorkerReply): void {
+    if (m.kind === 'brush') {
+      this.brushReplies.get(m.id)?.(m.vertices);
+      this.brushReplies.delete(m.id);
+      return;
+    }
+    this.normalsBusy[m.slot] = false;
+    const newer = m.slot === 'full' || !this.fullAfter(m.seq);
+    if (m.slot === 'full') this.viewer.setPositions(m.positions, m.normals);
+    else if (newer) this.viewer.showPreview(m.positions, m.normals);
+    if (m.slot === 'preview') stats.previewsDrawn++;
+    this.pendingDraw = Math.max(this.pendingDraw ?? 0, m.seq);
+    const queued = this.normalsQueued[m.slot];
+    this.normalsQueued[m.slot] = null;
+    if (queued) this.computeNormals(m.slot, queued);
+  }
+
+  // Whether a full frame newer than `seq` is already shown or on its way.
+  private fullAfter(seq: number): boolean {
+    const f = this.normalsQueued.full;
+    return (f !== null && f.seq > seq) || (!this.viewer.showingPreview && this.lastDrawn > seq);
+  }
+
+  private post(request: WorkerRequest, transfer = false): void {
+    const buffers = request.kind === 'normals' && transfer ? [request.positions.buffer] : [];
+    this.worker.postMessage(request, buffers);
+  }
+
+  private onRendered(): void {
+    if (this.pendingDraw === null) return;
+    const t = this.sentAt.get(this.pendingDraw);
+    const now = performance.now();
+    if (t !== undefined) stats.latencies.push(now - t);
+    for (const s of this.sentAt.keys()) if (s <= this.pendingDraw) this.sentAt.delete(s);
+    stats.framesDrawn++;
+    stats.drawTimes.push(now);
+    if (stats.drawTimes.length > 2000) stats.drawTimes.splice(0, 1000);
+    this.lastDrawn = this.pendingDraw;
+    this.pendingDraw = null;
+  }
+
+  private adoptMesh(m: P.MeshMessage): void {
+    const sameTriangles = m.indices.length === this.indices.length && m.indices.every((v, i) => v === this.indices[i]);
+    const samePositions = sameTriangles && m.positions.every((v, i) => v === this.rest[i]);
+    if (samePositions) return; // a reconnection: keep the view and what is shown
+    this.rest = m.positions.slice();
+    const n = this.rest.length / 3;
+    this.viewer.setMesh(this.rest, m.indices, sameTriangles);
+    this.post({ kind: 'mesh', slot: 'full', indices: m.indices.slice(), vertices: n });
+    this.computeNormals('full', { seq: this.seq, positions: this.rest } as P.FrameResult);
+    if (!sameTriangles) {
+      // Another mesh: the selection goes (the server says so too), the preview is measured again.
+      this.indices = m.indices.slice();
+      this.labels = new Int16Array(n);
+      this.groups = [{ transform: new THREE.Matrix4(), pinned: false }];
+      this.activeGroup = 0;
+      this.previewWanted = false;
+      this.drawMs = 0;
+      this.paint();
+    }
+  }
+
+  private adoptReady(m: P.ReadyMessage): void {
+    const previous = this.ready;
+    const newMesh = !previous || previous.mesh_id !== m.mesh_id;
+    if (!this.restoreChecked && previous && !newMesh &&
+        (previous.modes !== m.modes || JSON.stringify(previous.settings) !== JSON.stringify(m.settings))) {
+      this.restoreSettings = { type: 'settings', modes: previous.modes, ...previous.settings };
+    }
+    this.ready = m;
+    if (m.basis.warning) this.note(m.basis.warning, 'error');
+    if (newMesh) requestAnimationFrame(() => this.choosePreview());
+  }
+
+  // Measures the full mesh's draw once; if it is too slow for drags, asks for a preview that
+  // draws in about kPreviewMs.
+  private choosePreview(): void {
+    if (!this.ready || this.rest.length === 0) return;
+    this.drawMs = this.viewer.measureDraw();
+    const n = this.rest.length / 3;
+    const wanted = this.drawMs > kFullDrawBudgetMs;
+    const size = Math.round(Math.max(2000, Math.min(n / 3, (n * kPreviewMs) / this.drawMs)));
+    this.previewWanted = wanted;
+    if (wanted && this.viewer.previewSize !== size) this.connection.send({ type: 'preview', vertices: size });
+    this.changed();
+  }
+
+  private adoptSelection(s: P.Selection): void {
+    if (!this.restoreChecked && s.groups.length === 0 && s.fixed.length === 0 && this.labels.some((l) => l !== FREE)) {
+      this.restoring = true; // decided on the "state" that follows
+      return;
+    }
+    this.labels.fill(FREE);
+    s.fixed.forEach((v) => (this.labels[v] = FIXED));
+    s.groups.forEach((g, k) => g.vertices.forEach((v) => (this.labels[v] = 2 + k)));
+    this.groups = s.groups.map((g) => ({ transform: fromRowMajor(g.transform), pinned: g.pinned }));
+    if (this.groups.length === 0) this.groups = [{ transform: new THREE.Matrix4(), pinned: false }];
+    this.activeGroup = Math.min(this.activeGroup, this.groups.length - 1);
+    if (!this.hasHandles()) this.computeNormals('full', { seq: this.seq, positions: this.rest } as P.FrameResult);
+    this.paint();
+  }
+
+  private adoptState(m: P.StateMessage): void {
+    this.pendingSelections = Math.max(0, this.pendingSelections - 1);
+    if (!this.restoreChecked) {
+      this.restoreChecked = true;
+      const restarted = m.groups.length === 0 && m.fixed === 0 && !m.undo;
+      const restoring = this.restoring;
+      const settings = this.restoreSettings;
+      this.restoring = false;
+      this.restoreSettings = null;
+      if (restarted && (restoring || settings)) {
+        // The server restarted on the mesh this page has: it gets this page's edit back.
+        this.server = m;
+        if (settings) this.connection.send(settings);
+        if (restoring) this.sendSelection();
+        // Everything back as the server has it now (replies to a hello sent before are on
+        // their way, with its empty selection).
+        this.connection.send({ type: 'hello' });
+        this.note('the server restarted: your settings, selection and handles were restored');
+        return;
+      }
+      if (restoring) this.adoptSelection({ groups: [], fixed: new Uint32Array(0) });
+    }
+    this.server = m;
+    m.groups.forEach((g, k) => {
+      if (!this.groups[k]) this.groups[k] = { transform: new THREE.Matrix4(), pinned: false };
+      this.groups[k].pinned = g.pinned;
+      if (g.pinned) this.groups[k].transform = fromRowMajor(g.transform);
+    });
+    if (m.pin_error > 0.002) {
+      this.note(`the pinned region bends: it holds its place within ${(100 * m.pin_error).toFixed(2)}% ` +
+        'of the diagonal (Apply pose holds it exactly)');
+    }
+  }
+
+  // Colours from labels, for all vertices or the ones listed.
+  paint(vertices?: ArrayLike<number>): void {
+    const n = this.labels.length;
+    const colors = this.colorBuffer.length === 3 * n ? this.colorBuffer : (this.colorBuffer = new Float32Array(3 * n));
+    const set = (v: number) => {
+      const l = this.labels[v];
+      const c = l === FREE ? FREE_COLOR : l === FIXED ? FIXED_COLOR
+        : this.groups[l - 2]?.pinned ? PIN_COLOR : GROUP_COLORS[(l - 2) % GROUP_COLORS.length];
+      colors[3 * v] = c.r;
+      colors[3 * v + 1] = c.g;
+      colors[3 * v + 2] = c.b;
+    };
+    if (vertices) for (let i = 0; i < vertices.length; ++i) set(vertices[i]);
+    else for (let v = 0; v < n; ++v) set(v);
+    this.viewer.setColors(colors, vertices);
+  }
+  private colorBuffer = new Float32Array(0);
+
+  connect(): void {
+    this.connection.connect();
+  }
+}
+
+export const GROUP_HEX = [0xf28e2b, 0x59a14f, 0xb07aa1, 0x76b7b2, 0xedc948, 0xe15759, 0x9c755f];
+const GROUP_COLORS = GROUP_HEX.map((c) => new THREE.Color(c));
+const FREE_COLOR = new THREE.Color(0xc9ccd3);
+export const FIXED_HEX = 0x4e79a7;
+const FIXED_COLOR = new THREE.Color(FIXED_HEX);
+export const PIN_HEX = 0x1f3b63;
+const PIN_COLOR = new THREE.Color(PIN_HEX);
+
+export function rowMajor(m: THREE.Matrix4): P.Matrix {
+  return m.clone().transpose().toArray();
+}
+
+export function fromRowMajor(a: P.Matrix): THREE.Matrix4 {
+  return new THREE.Matrix4().fromArray(a).transpose();
+}
+
+function requestName(request: string): string {
+  const names: Record<string, string> = {
+    mesh_file: 'open mesh', selection_file: 'load selection', scene_file: 'open scene',
+    open_demo: 'open the demo', apply_pose: 'apply pose', export_mesh: 'export mesh', export_scene: 'export scene',
+    selection: 'selection', frame: 'drag', settings: 'settings', undo: 'undo', redo: 'redo', open: 'open',
+  };
+  return names[request] ?? request;
+}
