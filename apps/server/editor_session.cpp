@@ -203,8 +203,11 @@ void EditorSession::dispatch(bool binary, std::string_view message) {
   State& s = *state_;
   const int n = s.loaded.mesh.num_vertices();
   switch (tag) {
-    case Tag::Selection:
-      return set_edit(decode_selection(message, n), true, false);
+    case Tag::Selection: {
+      GroupSelection edit = decode_selection(message, n);
+      const bool echo = edit.echo;
+      return set_edit(std::move(edit), true, echo);
+    }
     case Tag::Frame: {
       if (!s.has_handles) throw InputError("frame message: select a handle first");
       const FrameRequest f = decode_frame(message, static_cast<int>(s.edit.transforms.size()));
@@ -390,6 +393,7 @@ void EditorSession::set_edit(GroupSelection edit, bool record, bool echo) {
     pin_error = std::max(pin_error, fit.max_error / s.diagonal);
   }
   edit.fit.assign(groups, false);
+  edit.echo = false;
   size_t handle_vertices = 0;
   for (const auto& g : edit.selection.handles) handle_vertices += g.size();
   const Clock::time_point start = Clock::now();

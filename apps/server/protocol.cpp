@@ -86,17 +86,19 @@ GroupSelection decode_selection(std::string_view message, int num_vertices) {
   Reader r(message, "selection");
   r.get<uint32_t>();
   const uint32_t groups = r.get<uint32_t>(), fixed = r.get<uint32_t>();
-  r.get<uint32_t>();
+  const uint32_t flags = r.get<uint32_t>();
+  if (flags > 1) r.fail("unknown flags");
   if (groups > kMaxGroups) r.fail(std::to_string(groups) + " handle groups (at most 64)");
   std::vector<uint32_t> sizes(groups);
   uint64_t total = fixed;
   for (uint32_t& s : sizes) total += s = r.get<uint32_t>();
   GroupSelection out;
+  out.echo = flags == 1;
   for (uint32_t g = 0; g < groups; ++g) {
-    const uint32_t flags = r.get<uint32_t>();
-    if (flags > 3) r.fail("group " + std::to_string(g) + " has unknown flags");
-    out.pinned.push_back((flags & 1) != 0);
-    out.fit.push_back((flags & 2) != 0);
+    const uint32_t group_flags = r.get<uint32_t>();
+    if (group_flags > 3) r.fail("group " + std::to_string(g) + " has unknown flags");
+    out.pinned.push_back((group_flags & 1) != 0);
+    out.fit.push_back((group_flags & 2) != 0);
   }
   r.align8();
   for (uint32_t g = 0; g < groups; ++g) {
@@ -162,7 +164,7 @@ std::string encode_selection(const GroupSelection& s, Tag tag) {
   w.put(static_cast<uint32_t>(tag));
   w.put(static_cast<uint32_t>(selection.handles.size()));
   w.put(static_cast<uint32_t>(selection.fixed.size()));
-  w.put(uint32_t{0});
+  w.put(uint32_t{s.echo ? 1u : 0u});
   const size_t groups = selection.handles.size();
   for (const auto& g : selection.handles) w.put(static_cast<uint32_t>(g.size()));
   for (size_t g = 0; g < groups; ++g) {

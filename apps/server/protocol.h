@@ -6,7 +6,8 @@
 // element size, so the browser reads them with typed arrays in place.
 //
 // Browser -> server
-//   1 selection    u32 tag | u32 groups G | u32 fixed F | u32 0 | u32 size of each group (G) |
+//   1 selection    u32 tag | u32 groups G | u32 fixed F | u32 flags (bit 0: echo, answer with
+//                  104 as well: a restored selection) | u32 size of each group (G) |
 //                  u32 flags of each group (G; bit 0: pinned, bit 1: fit, see GroupSelection) |
 //                  f64 4 x 4 row-major transform of each group (16 G) |
 //                  u32 fixed vertices (F) | u32 vertices of group 0, 1, ... (mesh numbering)
@@ -67,6 +68,7 @@ struct GroupSelection {
   Selection selection;
   std::vector<Eigen::Affine3d> transforms;  // one per group
   std::vector<bool> pinned, fit;            // one per group
+  bool echo = false;                        // the server sends it back (a restored edit)
 };
 
 struct FrameRequest {

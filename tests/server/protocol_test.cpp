@@ -22,11 +22,13 @@ TEST(Protocol, SelectionRoundTrips) {
       Eigen::Translation3d(1, 2, 3) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX());
   s.pinned[2] = true;
   s.fit[2] = true;
+  s.echo = true;
   const GroupSelection back = decode_selection(encode_selection(s, Tag::Selection), 8);
   EXPECT_EQ(back.selection.handles, s.selection.handles);
   EXPECT_EQ(back.selection.fixed, s.selection.fixed);
   EXPECT_EQ(back.pinned, s.pinned);
   EXPECT_EQ(back.fit, s.fit);
+  EXPECT_TRUE(back.echo);
   EXPECT_TRUE(back.transforms[1].matrix().isApprox(s.transforms[1].matrix(), 0));
 }
 

@@ -107,6 +107,9 @@ try {
     check((await page.inputValue('#modes')) === '50', 'm = 50 was applied');
   }
 
+  // Messages read, as a user would dismiss them before painting under them.
+  for (const close of await page.$$('#notes .note button')) await close.click();
+
   // The two ends of the model along its longest axis, among the vertices facing the camera.
   const ends = await api(() => {
     const e = window.specdeformEditor;
@@ -129,7 +132,7 @@ try {
         const far = sign * (p[3 * v + axis] - (sign > 0 ? hi[axis] : lo[axis])) > -0.03 * (hi[axis] - lo[axis]);
         if (!far) continue;
         const s = e.vertexOnScreen(v);
-        if (s.x < rect.left + 20 || s.x > rect.right - 20 || s.y < rect.top + 150 || s.y > rect.bottom - 40) continue;
+        if (s.x < rect.left + 20 || s.x > rect.right - 20 || s.y < rect.top + 20 || s.y > rect.bottom - 40) continue;
         if (best < 0 || d(v) < d(best)) best = v;
       }
       return best;

@@ -260,7 +260,7 @@ export class Interaction {
     clearTimeout(this.restTimer);
     if (!keep) this.s.groups[d.group].transform = d.transform;
     if (this.usedPreview || !keep) this.s.sendFrame(false);
-    if (keep) this.s.connection.send({ type: 'commit' });
+    if (keep) this.s.commit();
     this.placeGizmo();
     this.s.changed();
   }

@@ -130,7 +130,7 @@ export class Panel {
     $('reset').addEventListener('click', () => {
       for (const g of s.groups) if (!g.pinned) g.transform.identity();
       s.sendFrame(false);
-      s.connection.send({ type: 'commit' });
+      s.commit();
       this.ui.placeGizmo();
     });
     $('apply-pose').addEventListener('click', () => s.request({ type: 'apply_pose' }, 'apply pose', 'state'));

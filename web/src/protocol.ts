@@ -94,6 +94,7 @@ export type ClientText =
 export interface Selection {
   groups: { vertices: Uint32Array; transform: Matrix; pinned: boolean; fit?: boolean }[];
   fixed: Uint32Array;
+  echo?: boolean; // the server sends it back (a restored edit)
 }
 
 export interface MeshMessage {
@@ -131,7 +132,7 @@ export function encodeSelection(s: Selection): ArrayBuffer {
   const head = 16 + 8 * G; // a multiple of 8: the transforms follow aligned
   const buffer = new ArrayBuffer(head + 128 * G + 4 * total);
   const u = new Uint32Array(buffer, 0, head / 4);
-  u.set([Tag.Selection, G, s.fixed.length, 0]);
+  u.set([Tag.Selection, G, s.fixed.length, s.echo ? 1 : 0]);
   s.groups.forEach((g, i) => {
     u[4 + i] = g.vertices.length;
     u[4 + G + i] = (g.pinned ? 1 : 0) | (g.fit ? 2 : 0);

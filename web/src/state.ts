@@ -72,7 +72,8 @@ export class EditorState {
   private restoreChecked = true;
   private restoring = false; // the server sent an empty selection where this page has one
   private restoreSettings: P.ClientText | null = null;
-  private pendingSelections = 0;
+  private awaitingStates = 0; // requests sent whose "state" (or "empty", or error) is to come
+  private restorePending = false; // a restored selection is on its way back
 
   constructor(readonly viewer: Viewer) {
     this.connection = new Connection(`ws://${location.host}/ws`, {
@@ -114,12 +115,14 @@ export class EditorState {
       return false;
     }
     this.connection.send(message);
+    if (expects === 'state') ++this.awaitingStates;
     this.phase = { kind: 'busy', what, expects };
     this.changed();
     return true;
   }
 
-  sendSelection(fit: Set<number> = new Set()): void {
+  // `fit`: pinned groups whose transform the server fits; `echo`: it sends the selection back.
+  sendSelection(fit: Set<number> = new Set(), echo = false): void {
     const s: P.Selection = {
       groups: this.groups.map((g, k) => ({
         vertices: new Uint32Array(0),
@@ -128,6 +131,7 @@ export class EditorState {
         fit: fit.has(k),
       })),
       fixed: new Uint32Array(0),
+      echo,
     };
     const lists: number[][] = this.groups.map(() => []);
     const fixed: number[] = [];
@@ -137,7 +141,7 @@ export class EditorState {
     });
     s.groups.forEach((g, k) => (g.vertices = Uint32Array.from(lists[k])));
     s.fixed = Uint32Array.from(fixed);
-    if (this.connection.send(P.encodeSelection(s))) ++this.pendingSelections;
+    if (this.connection.send(P.encodeSelection(s))) ++this.awaitingStates;
     else this.note('the selection was not sent: not connected (it is sent again on reconnection)', 'error');
   }
 
@@ -152,6 +156,11 @@ export class EditorState {
 
   get lastSeq(): number {
     return this.seq;
+  }
+
+  // The transforms as they are now become an undo step.
+  commit(): void {
+    if (this.connection.send({ type: 'commit' })) ++this.awaitingStates;
   }
 
   hasHandles(): boolean {
@@ -173,7 +182,7 @@ export class EditorState {
   }
 
   settled(): boolean {
-    return this.outstanding === null && this.pendingDraw === null && this.pendingSelections === 0 && !this.painting &&
+    return this.outstanding === null && this.pendingDraw === null && this.awaitingStates === 0 && !this.painting &&
       !this.normalsBusy.full && this.phase.kind !== 'busy';
   }
 
@@ -193,10 +202,11 @@ export class EditorState {
       this.outstanding = null;
       this.restoreChecked = !this.wasOpen; // after a reconnection: does the server still have the edit?
       this.wasOpen = true;
+      this.awaitingStates = 1;
       this.connection.send({ type: 'hello' });
     } else if (s.kind === 'closed') {
       this.phase = { kind: 'disconnected', reason: s.reason, retryAt: s.retryAt };
-      this.pendingSelections = 0;
+      this.awaitingStates = 0;
       this.note(`disconnected: ${s.reason}`, 'error');
     } else if (this.phase.kind !== 'disconnected') {
       this.phase = { kind: 'connecting' };
@@ -218,12 +228,14 @@ export class EditorState {
         if (this.phase.kind !== 'busy' || this.phase.expects !== 'file') this.phase = { kind: 'ready' };
         break;
       case 'empty':
+        this.awaitingStates = Math.max(0, this.awaitingStates - 1);
         this.phase = { kind: 'empty' };
         this.ready = null;
         break;
       case 'error':
-        if (m.request === 'selection') this.pendingSelections = Math.max(0, this.pendingSelections - 1);
-        this.note(m.cancelled ? m.message : `${requestName(m.request)}: ${m.message}`, m.cancelled ? 'info' : 'error');
+        if (STATE_REQUESTS.has(m.request)) this.awaitingStates = Math.max(0, this.awaitingStates - 1);
+        this.note(m.cancelled || m.message.startsWith(`${m.request}:`) ? m.message : `${requestName(m.request)}: ${m.message}`,
+          m.cancelled ? 'info' : 'error');
         this.phase = this.ready ? { kind: 'ready' } : { kind: 'empty' };
         break;
     }
@@ -363,7 +375,12 @@ export class EditorState {
   }
 
   private adoptSelection(s: P.Selection): void {
-    if (!this.restoreChecked && s.groups.length === 0 && s.fixed.length === 0 && this.labels.some((l) => l !== FREE)) {
+    const empty = s.groups.length === 0 && s.fixed.length === 0;
+    if (this.restorePending) {
+      if (empty) return; // an earlier reply: the restored selection follows
+      this.restorePending = false;
+    }
+    if (!this.restoreChecked && empty && this.labels.some((l) => l !== FREE)) {
       this.restoring = true; // decided on the "state" that follows
       return;
     }
@@ -378,7 +395,7 @@ export class EditorState {
   }
 
   private adoptState(m: P.StateMessage): void {
-    this.pendingSelections = Math.max(0, this.pendingSelections - 1);
+    this.awaitingStates = Math.max(0, this.awaitingStates - 1);
     if (!this.restoreChecked) {
       this.restoreChecked = true;
       const restarted = m.groups.length === 0 && m.fixed === 0 && !m.undo;
@@ -390,10 +407,11 @@ export class EditorState {
         // The server restarted on the mesh this page has: it gets this page's edit back.
         this.server = m;
         if (settings) this.connection.send(settings);
-        if (restoring) this.sendSelection();
-        // Everything back as the server has it now (replies to a hello sent before are on
-        // their way, with its empty selection).
-        this.connection.send({ type: 'hello' });
+        // Echoed: the replies to a hello sent before, with its empty selection, come first.
+        if (restoring) {
+          this.restorePending = true;
+          this.sendSelection(new Set(), true);
+        }
         this.note('the server restarted: your settings, selection and handles were restored');
         return;
       }
@@ -449,6 +467,10 @@ export function rowMajor(m: THREE.Matrix4): P.Matrix {
 export function fromRowMajor(a: P.Matrix): THREE.Matrix4 {
   return new THREE.Matrix4().fromArray(a).transpose();
 }
+
+// Requests answered with "state" (or "empty"), or with an error naming them.
+const STATE_REQUESTS = new Set(['selection', 'commit', 'hello', 'undo', 'redo', 'apply_pose', 'open_demo',
+  'mesh_file', 'selection_file', 'scene_file']);
 
 function requestName(request: string): string {
   const names: Record<string, string> = {

@@ -269,7 +269,7 @@ export class Viewer {
 
   private frameSphere(sphere: THREE.Sphere, direction = new THREE.Vector3(0.25, 0.35, 1)): void {
     const distance = sphere.radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2));
-    this.camera.position.copy(sphere.center).add(direction.normalize().multiplyScalar(1.05 * distance));
+    this.camera.position.copy(sphere.center).add(direction.normalize().multiplyScalar(1.15 * distance));
     this.orbit.target.copy(sphere.center);
     this.orbit.update();
     this.requestRender();
