@@ -97,6 +97,13 @@ net::awaitable<void> run_client(uint16_t port, sd::Selection selection, Drag dra
   groups.pinned.assign(selection.handles.size(), false);
   const std::string message = sd::server::encode_selection(groups, sd::server::Tag::Selection);
   co_await ws.async_write(net::buffer(message), net::use_awaitable);
+  for (int states = 0; states < 2;) {  // the connection's state (a hello), the selection's
+    beast::flat_buffer buffer;
+    co_await ws.async_read(buffer, net::use_awaitable);
+    const std::string m = beast::buffers_to_string(buffer.data());
+    if (m.find("\"error\"") != std::string::npos) throw std::runtime_error(m);
+    if (!ws.got_binary() && m.find("\"state\"") != std::string::npos) ++states;
+  }
 
   // A mouse: frames at a fixed rate, results read as they come.
   std::map<uint32_t, Clock::time_point> sent;
