@@ -296,11 +296,14 @@ export class Interaction {
     this.s.labels.forEach((l, k) => {
       if (l === 2 + g) radius = Math.max(radius, centroid.distanceTo(new THREE.Vector3().fromArray(rest, 3 * k)));
     });
-    // To the camera's right, by the group's size plus the gizmo's reach (TransformControls
-    // scales itself with the distance to the camera: its arrows reach about 0.1 of it).
+    // Beside the group, away from the model's centre as seen from the camera, by the group's
+    // size plus the gizmo's reach (TransformControls scales itself with the distance to the
+    // camera: its arrows reach about 0.1 of it).
     const at = centroid.clone().applyMatrix4(group.transform);
-    const right = new THREE.Vector3().setFromMatrixColumn(v.camera.matrixWorld, 0);
-    at.add(right.multiplyScalar(radius + 0.15 * at.distanceTo(v.camera.position)));
+    const view = v.camera.getWorldDirection(new THREE.Vector3());
+    const away = at.clone().sub(v.orbit.target).projectOnPlane(view);
+    if (away.lengthSq() < 1e-12 * at.lengthSq() + 1e-30) away.setFromMatrixColumn(v.camera.matrixWorld, 0);
+    at.add(away.normalize().multiplyScalar(radius + 0.15 * at.distanceTo(v.camera.position)));
     if (this.drag?.pivot) return; // the gizmo moves itself while dragged
     v.pivot.position.copy(at);
     v.pivot.quaternion.identity();

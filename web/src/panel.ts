@@ -240,7 +240,7 @@ export class Panel {
     // The panel: what can be done now.
     $('mesh-name').textContent = r
       ? `${r.name}: ${r.vertices.toLocaleString()} vertices, ${r.faces.toLocaleString()} triangles`
-      : phase.kind === 'empty' ? 'no mesh open' : 'connecting…';
+      : phase.kind === 'empty' ? 'no mesh open' : phase.kind === 'loading' ? 'preparing the mesh…' : 'connecting…';
     const enable = (id: string, on: boolean) => ($<HTMLButtonElement>(id).disabled = !on);
     for (const id of ['undo', 'redo', 'reset', 'apply-pose', 'export-mesh', 'export-scene', 'clear', 'new-group',
       'energy', 'ks', 'kb', 'detail', 'constraints', 'modes', 'show-base', 'group', 'export-format']) {

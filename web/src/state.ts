@@ -198,6 +198,7 @@ export class EditorState {
 
   private onStatus(s: ConnectionStatus): void {
     if (s.kind === 'open') {
+      if (this.phase.kind === 'disconnected') this.note('reconnected to the server');
       this.phase = { kind: 'connecting' };
       this.outstanding = null;
       this.restoreChecked = !this.wasOpen; // after a reconnection: does the server still have the edit?
@@ -205,9 +206,10 @@ export class EditorState {
       this.awaitingStates = 1;
       this.connection.send({ type: 'hello' });
     } else if (s.kind === 'closed') {
+      // The banner stays while disconnected; the log says when it started.
+      if (this.phase.kind !== 'disconnected') this.note(`disconnected: ${s.reason}`);
       this.phase = { kind: 'disconnected', reason: s.reason, retryAt: s.retryAt };
       this.awaitingStates = 0;
-      this.note(`disconnected: ${s.reason}`, 'error');
     } else if (this.phase.kind !== 'disconnected') {
       this.phase = { kind: 'connecting' };
     }
@@ -297,7 +299,6 @@ export class EditorState {
     const newer = m.slot === 'full' || !this.fullAfter(m.seq);
     if (m.slot === 'full') this.viewer.setPositions(m.positions, m.normals);
     else if (newer) this.viewer.showPreview(m.positions, m.normals);
-    if (m.slot === 'preview') stats.previewsDrawn++;
     this.pendingDraw = Math.max(this.pendingDraw ?? 0, m.seq);
     const queued = this.normalsQueued[m.slot];
     this.normalsQueued[m.slot] = null;
@@ -322,6 +323,7 @@ export class EditorState {
     if (t !== undefined) stats.latencies.push(now - t);
     for (const s of this.sentAt.keys()) if (s <= this.pendingDraw) this.sentAt.delete(s);
     stats.framesDrawn++;
+    if (this.viewer.showingPreview) stats.previewsDrawn++;
     stats.drawTimes.push(now);
     if (stats.drawTimes.length > 2000) stats.drawTimes.splice(0, 1000);
     this.lastDrawn = this.pendingDraw;
