@@ -129,8 +129,12 @@ struct EditorSession::State {
   std::vector<Entry> history;
   size_t at = 0;
   uint32_t seq = 0;
-  Vertices result;  // the last detailed result (the rest shape before any frame)
+  Vertices result;            // the last detailed result (the rest shape before any frame)
+  bool result_stale = false;  // previews were solved since
   std::optional<PreviewMesh> preview;
+  // The deformer of previews: the same without details (DetailMethod::None), so that a preview
+  // frame skips the detail reconstruction; the preview adds them back as displacements.
+  std::optional<SpectralDeformer> sketch;
   double selection_seconds = 0.0, pin_error = 0.0;
 
   const Vertices& rest() const { return poses[pose].rest; }
@@ -280,13 +284,14 @@ void EditorSession::text_message(std::string_view message) {
     const int64_t k = j["vertices"].get<int64_t>();
     s.preview = make_preview(s.rest_mesh(s.pose),
                              static_cast<int>(std::clamp<int64_t>(k, 0, s.rest().rows())));
+    sync_sketch();
     return send_(true, encode_preview(*s.preview));
   }
   if (type == "export_mesh") {
     const std::string format = j.value("format", "obj");
     const std::filesystem::path out =
         std::filesystem::path(s.name).stem().string() + "-deformed." + format;
-    const TriangleMesh file_order = to_file_order(s.loaded.info, s.result, s.loaded.mesh.F);
+    const TriangleMesh file_order = to_file_order(s.loaded.info, result(), s.loaded.mesh.F);
     return send_(true,
                  encode_file({out.string(), encode_mesh(file_order, mesh_format_from_path(out))}));
   }
@@ -372,6 +377,7 @@ void EditorSession::change_settings(std::string_view message) {
     s.options = o;
     config_.modes = modes;  // meshes opened later start with these settings too
     config_.options = o;
+    sync_sketch();
   }
   s.base_view = base_view;
   solve_and_send();
@@ -388,7 +394,7 @@ void EditorSession::set_edit(GroupSelection edit, bool record, bool echo) {
   double pin_error = 0.0;
   for (size_t g = 0; g < groups; ++g) {
     if (!edit.fit[g] || !edit.pinned[g] || edit.selection.handles[g].empty()) continue;
-    const FittedTransform fit = fit_transform(s.rest(), s.result, edit.selection.handles[g]);
+    const FittedTransform fit = fit_transform(s.rest(), result(), edit.selection.handles[g]);
     edit.transforms[g] = fit.transform;
     pin_error = std::max(pin_error, fit.max_error / s.diagonal);
   }
@@ -404,12 +410,13 @@ void EditorSession::set_edit(GroupSelection edit, bool record, bool echo) {
       if (s.has_handles) s.deformer->set_selection(s.edit.selection);
       throw;
     }
+    if (s.sketch) s.sketch->set_selection(edit.selection);
   }
   s.selection_seconds = seconds_since(start);
   s.pin_error = pin_error;
   s.has_handles = handle_vertices > 0;
   s.edit = std::move(edit);
-  if (!s.has_handles) s.result = s.rest();
+  if (!s.has_handles) s.result = s.rest(), s.result_stale = false;
   if (record) push_history();
   if (echo) send_selection();
   if (s.has_handles) solve_and_send();
@@ -444,6 +451,8 @@ void EditorSession::restore(size_t entry) {
     s.pose = e.pose;
     s.has_handles = false;
     s.result = s.rest();
+    s.result_stale = false;
+    sync_sketch();
     send_mesh();
     send_ready();
   }
@@ -454,7 +463,7 @@ void EditorSession::restore(size_t entry) {
 void EditorSession::apply_pose() {
   State& s = *state_;
   if (!s.has_handles) throw InputError("apply pose: nothing is moved yet (drag a handle first)");
-  const TriangleMesh posed{s.result, s.loaded.mesh.F};
+  const TriangleMesh posed{result(), s.loaded.mesh.F};
   Basis basis;
   const Clock::time_point start = Clock::now();
   auto reused = std::make_shared<ManifoldHarmonics>(reuse_basis(posed, *s.basis().harmonics));
@@ -490,6 +499,8 @@ void EditorSession::apply_pose() {
   s.pose = static_cast<int>(s.poses.size()) - 1;
   s.has_handles = false;
   s.result = s.rest();
+  s.result_stale = false;
+  sync_sketch();
   send_mesh();
   send_ready();
   set_edit(std::move(edit), true, true);
@@ -681,6 +692,23 @@ void EditorSession::send_state() {
                      {"pose", s.pose}}));
 }
 
+void EditorSession::sync_sketch() {
+  State& s = *state_;
+  s.sketch.reset();
+  if (!s.preview) return;
+  DeformOptions o = s.options;
+  o.detail = DetailMethod::None;
+  s.sketch.emplace(s.rest_mesh(s.pose), s.basis().harmonics, o);
+  if (s.has_handles) s.sketch->set_selection(s.edit.selection);
+}
+
+const Vertices& EditorSession::result() {
+  State& s = *state_;
+  if (s.result_stale) s.result = s.deformer->solve(s.edit.transforms);
+  s.result_stale = false;
+  return s.result;
+}
+
 void EditorSession::solve_and_send(bool preview) {
   State& s = *state_;
   const FrameView view{s.base_view, preview && s.preview.has_value()};
@@ -688,17 +716,27 @@ void EditorSession::solve_and_send(bool preview) {
   if (!s.has_handles) {
     return send_(true, encode_frame_result(s.seq, view, {}, s.rest(), coarse));
   }
-  s.result = s.deformer->solve(s.edit.transforms);
-  const FrameTimings& t = s.deformer->frame_timings();
-  const ConstraintError e = s.deformer->constraint_error(s.result);
-  const ArapReport& arap = s.deformer->arap_report();
+  SpectralDeformer& deformer = view.preview ? *s.sketch : *s.deformer;
+  Vertices shown = deformer.solve(s.edit.transforms);
+  if (view.preview) {
+    if (!s.base_view) shown += s.rest() - deformer.base();  // the details as displacements
+    s.result_stale = true;
+  } else {
+    s.result = std::move(shown);
+    s.result_stale = false;
+  }
+  const FrameTimings& t = deformer.frame_timings();
+  const ConstraintError e = deformer.constraint_error(view.preview ? shown : s.result);
+  const ArapReport& arap = deformer.arap_report();
   const FrameStats stats{
       t.reduced_solve, t.inverse_transform,
       t.detail,        t.total,
       e.max,           e.rms,
       arap.iterations, s.options.energy == DeformEnergy::Linear || arap.converged};
-  send_(true, encode_frame_result(s.seq, view, stats,
-                                  s.base_view ? s.deformer->deformed_base() : s.result, coarse));
+  const Vertices& positions = view.preview  ? shown
+                              : s.base_view ? s.deformer->deformed_base()
+                                            : s.result;
+  send_(true, encode_frame_result(s.seq, view, stats, positions, coarse));
 }
 
 }  // namespace specdeform::server

@@ -117,7 +117,10 @@ class EditorSession {
   void restore(size_t entry);
   void apply_pose();
   void open_scene(const NamedFile& file);
+  // `preview`: solved without details and sent at the preview's vertices only.
   void solve_and_send(bool preview = false);
+  void sync_sketch();        // the previews' deformer after the deformer changed
+  const Vertices& result();  // the detailed result of the current transforms
   void send_mesh();
   void send_ready();
   void send_selection();
