@@ -19,19 +19,19 @@ const browser = await launchChromium();
 try {
   const page = await browser.newPage({ viewport: { width: 900, height: 900 } });
   await page.goto(await url);
-  await page.addStyleTag({ content: '#panel { display: none !important; }' });
+  await page.addStyleTag({ content: '#panel, #overlay, #help, #log-box, #banner { display: none !important; }' });
   await page.waitForFunction(() => window.specdeformEditor?.ready, null, { timeout: 300000 });
   for (const job of jobs) {
     const name = basename(job.mesh);
     await page.setInputFiles('#open-mesh', job.mesh);
-    // The mesh is open when its name shows; an error line instead ends the run.
+    // The mesh is open when its name shows; an error message instead ends the run.
     const outcome = await page.waitForFunction(
       (n) => {
-        const error = document.querySelector('#message:not(.info)')?.textContent;
-        if (error) return { error };
+        const e = window.specdeformEditor;
+        const error = e.notes().find((note) => note.level === 'error');
+        if (error) return { error: error.text };
         const shown = document.querySelector('#mesh-name').textContent.startsWith(`${n}:`);
-        const idle = document.querySelector('#progress').hidden;
-        return window.specdeformEditor.ready && shown && idle ? { ok: true } : null;
+        return e.ready && e.settled() && shown ? { ok: true } : null;
       },
       name,
       { timeout: 300000 },

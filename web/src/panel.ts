@@ -4,7 +4,7 @@
 // state (render()); the controls send requests through it.
 import { Interaction, Tool } from './interaction';
 import * as P from './protocol';
-import { EditorState, FIXED_HEX, GROUP_HEX, PIN_HEX, stats } from './state';
+import { EditorState, GROUP_HEX, PIN_HEX, stats } from './state';
 
 const $ = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
 
@@ -272,7 +272,6 @@ export class Panel {
     this.lastPhase = phase.kind;
     if (!connected || !editable) s.viewer.gizmo.detach();
     else if (this.ui.tool === 'move' && !s.viewer.gizmo.object) this.ui.placeGizmo();
-    void FIXED_HEX;
   }
 
   // What to do next, from what is selected.

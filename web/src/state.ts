@@ -457,8 +457,7 @@ export class EditorState {
 export const GROUP_HEX = [0xf28e2b, 0x59a14f, 0xb07aa1, 0x76b7b2, 0xedc948, 0xe15759, 0x9c755f];
 const GROUP_COLORS = GROUP_HEX.map((c) => new THREE.Color(c));
 const FREE_COLOR = new THREE.Color(0xc9ccd3);
-export const FIXED_HEX = 0x4e79a7;
-const FIXED_COLOR = new THREE.Color(FIXED_HEX);
+const FIXED_COLOR = new THREE.Color(0x4e79a7);
 export const PIN_HEX = 0x1f3b63;
 const PIN_COLOR = new THREE.Color(PIN_HEX);
 
