@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "basis_store.h"
 #include "pose.h"
 #include "preview.h"
 #include "specdeform/deform/scene.h"
@@ -32,9 +33,6 @@ double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// The largest basis residual (eigen_residual) the editor works with, warning, when the solver
-// falls short of its tolerance.
-constexpr double kUsableResidual = 1e-6;
 // Undo steps kept, and poses whose basis stays in memory (older ones are computed again, or
 // loaded from the cache, when an undo returns to them).
 constexpr size_t kHistory = 200;
@@ -44,12 +42,6 @@ std::string hex(uint64_t v) {
   char s[17];
   std::snprintf(s, sizeof s, "%016llx", static_cast<unsigned long long>(v));
   return s;
-}
-
-std::filesystem::path cache_file(const std::filesystem::path& dir, const TriangleMesh& mesh,
-                                 int modes, MassType mass) {
-  return dir / (hex(mesh_hash(mesh)) + "-m" + std::to_string(modes) +
-                (mass == MassType::Lumped ? "-lumped" : "-consistent") + ".sdbasis");
 }
 
 Json matrix(const Eigen::Affine3d& t) {
@@ -96,13 +88,6 @@ void check_self_contained(const std::string& text, const std::string& name) {
 
 }  // namespace
 
-struct EditorSession::Basis {
-  std::shared_ptr<const ManifoldHarmonics> harmonics;  // null: to be computed again
-  double seconds = 0.0;
-  std::string source;   // computed, cache, reused
-  std::string warning;  // shown to the user
-};
-
 struct Pose {
   Vertices rest;
   std::string id;  // mesh_hash of the rest shape
@@ -117,7 +102,7 @@ struct EditorSession::State {
   LoadedMesh loaded;  // as read: the file's numbering, and the first pose's positions
   std::string name;
   std::vector<Pose> poses;
-  std::vector<Basis> bases;  // of each pose
+  std::vector<PreparedBasis> bases;  // of each pose
   int pose = 0;
   double diagonal = 1.0;
   int modes = 100;
@@ -139,7 +124,7 @@ struct EditorSession::State {
 
   const Vertices& rest() const { return poses[pose].rest; }
   TriangleMesh rest_mesh(int p) const { return {poses[p].rest, loaded.mesh.F}; }
-  const Basis& basis() const { return bases[pose]; }
+  const PreparedBasis& basis() const { return bases[pose]; }
 };
 
 LoadedMesh demo_mesh() {
@@ -365,12 +350,12 @@ void EditorSession::change_settings(std::string_view message) {
                             o.kb != s.options.kb || o.detail != s.options.detail ||
                             o.constraints != s.options.constraints;
   if (new_deformer) {
-    const Basis basis = new_basis ? compute_basis(s.rest_mesh(s.pose), modes) : s.basis();
+    const PreparedBasis basis = new_basis ? compute_basis(s.rest_mesh(s.pose), modes) : s.basis();
     SpectralDeformer deformer(s.rest_mesh(s.pose), basis.harmonics, o);
     if (s.has_handles) deformer.set_selection(s.edit.selection);
     s.deformer.emplace(std::move(deformer));
     if (new_basis) {  // the other poses' bases have the old m
-      for (Basis& b : s.bases) b.harmonics.reset();
+      for (PreparedBasis& b : s.bases) b.harmonics.reset();
       s.bases[s.pose] = basis;
     }
     s.modes = modes;
@@ -444,7 +429,7 @@ void EditorSession::restore(size_t entry) {
   State& s = *state_;
   const Entry& e = s.history[entry];
   if (e.pose != s.pose) {
-    Basis& basis = s.bases[e.pose];
+    PreparedBasis& basis = s.bases[e.pose];
     if (!basis.harmonics) basis = compute_basis(s.rest_mesh(e.pose), s.modes);
     SpectralDeformer deformer(s.rest_mesh(e.pose), basis.harmonics, s.options);
     s.deformer.emplace(std::move(deformer));
@@ -464,7 +449,7 @@ void EditorSession::apply_pose() {
   State& s = *state_;
   if (!s.has_handles) throw InputError("apply pose: nothing is moved yet (drag a handle first)");
   const TriangleMesh posed{result(), s.loaded.mesh.F};
-  Basis basis;
+  PreparedBasis basis;
   const Clock::time_point start = Clock::now();
   auto reused = std::make_shared<ManifoldHarmonics>(reuse_basis(posed, *s.basis().harmonics));
   if (reused->max_residual <= kReuseResidual) {
@@ -548,7 +533,7 @@ void EditorSession::open(LoadedMesh mesh, std::string name) {
   build(std::move(mesh), std::move(name), config_.modes, config_.options);
 }
 
-EditorSession::Basis EditorSession::compute_basis(const TriangleMesh& mesh, int modes) {
+PreparedBasis EditorSession::compute_basis(const TriangleMesh& mesh, int modes) {
   struct Computing {
     std::atomic<bool>& flag;
     explicit Computing(std::atomic<bool>& f) : flag(f) { flag = true; }
@@ -565,41 +550,7 @@ EditorSession::Basis EditorSession::compute_basis(const TriangleMesh& mesh, int 
                        {"fraction", fraction},
                        {"cancellable", true}}));
   };
-  Basis out;
-  const Clock::time_point start = Clock::now();
-  const std::filesystem::path cache =
-      config_.cache_dir.empty() ? std::filesystem::path()
-                                : cache_file(config_.cache_dir, mesh, modes, MassType::Lumped);
-  if (!cache.empty() && std::filesystem::exists(cache)) {
-    report(0.0, "loading the basis");
-    out.harmonics = std::make_shared<const ManifoldHarmonics>(load_basis(cache, mesh));
-    out.source = "cache";
-  } else {
-    ManifoldHarmonicsOptions o;
-    o.num_modes = modes;
-    o.progress = report;
-    auto basis = std::make_shared<ManifoldHarmonics>(compute_manifold_harmonics(mesh, o));
-    out.harmonics = basis;
-    out.source = "computed";
-    if (basis->status != SolveStatus::Converged) {
-      // Short of the tolerance but far below what a deformation can show (nearly degenerate
-      // triangles limit the attainable accuracy): usable, with a warning; not cached.
-      if (!(basis->max_residual <= kUsableResidual)) {
-        throw SolverError("the manifold harmonics did not converge: " +
-                          residual_summary(*basis, o.tolerance));
-      }
-      out.warning =
-          "the basis is less accurate than asked: " + residual_summary(*basis, o.tolerance);
-    } else if (!cache.empty()) {
-      try {
-        std::filesystem::create_directories(cache.parent_path());
-        save_basis(cache, *basis, mesh, BasisPrecision::Float64);
-      } catch (const std::exception& e) {
-        std::cerr << "specdeform: warning: basis not cached: " << e.what() << "\n";
-      }
-    }
-  }
-  out.seconds = seconds_since(start);
+  PreparedBasis out = prepare_basis(mesh, modes, config_.cache_dir, report);
   report(1.0, "factorizing");
   return out;
 }
@@ -612,7 +563,7 @@ void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
   State& s = *next;
   s.modes = std::min(modes, n - 1);
   s.options = options;
-  Basis basis;
+  PreparedBasis basis;
   try {
     basis = compute_basis(mesh.mesh, s.modes);
   } catch (const SolverError& e) {
@@ -641,7 +592,7 @@ void EditorSession::send_mesh() {
 void EditorSession::send_ready() {
   const State& s = *state_;
   const SetupTimings& t = s.deformer->setup_timings();
-  const Basis& b = s.basis();
+  const PreparedBasis& b = s.basis();
   send_(false, dump(Json{{"type", "ready"},
                          {"name", s.name},
                          {"vertices", s.loaded.mesh.num_vertices()},

@@ -40,6 +40,7 @@
 #include <string>
 #include <string_view>
 
+#include "basis_store.h"
 #include "protocol.h"
 #include "specdeform/deform/spectral_deformer.h"
 #include "specdeform/exceptions.h"
@@ -105,7 +106,6 @@ class EditorSession {
 
  private:
   struct State;
-  struct Basis;
   bool answer(const std::function<void()>& work);  // false: failed, answered with an error
   void dispatch(bool binary, std::string_view message);
   void text_message(std::string_view message);
@@ -126,7 +126,8 @@ class EditorSession {
   void send_selection();
   void send_state();
   void send_error(const std::string& message, bool cancelled = false);
-  Basis compute_basis(const TriangleMesh& mesh, int modes);
+  // prepare_basis() with progress messages, abandoned by cancel().
+  PreparedBasis compute_basis(const TriangleMesh& mesh, int modes);
   void build(LoadedMesh mesh, std::string name, int modes, const DeformOptions& options);
 
   EditorConfig config_;
