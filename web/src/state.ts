@@ -264,7 +264,7 @@ export class EditorState {
         this.frame = r;
         const slot: Slot = r.preview ? 'preview' : 'full';
         if (this.normalsBusy[slot]) this.normalsQueued[slot] = r; // latest wins
-        else this.computeNormals(slot, r);
+        else this.computeNormals(slot, r.seq, r.positions);
         return;
       }
       case P.Tag.File: {
@@ -282,11 +282,11 @@ export class EditorState {
     }
   }
 
-  private computeNormals(slot: Slot, r: P.FrameResult): void {
+  private computeNormals(slot: Slot, seq: number, positions: Float32Array): void {
     this.normalsBusy[slot] = true;
-    // A copy goes to the worker and comes back with its normals (the message's buffer may hold
-    // other fields).
-    this.post({ kind: 'normals', slot, seq: r.seq, positions: r.positions.slice() }, true);
+    // A copy goes to the worker and comes back with its normals (the message's buffer holds
+    // other fields too).
+    this.post({ kind: 'normals', slot, seq, positions: positions.slice() }, true);
   }
 
   private onWorker(m: WorkerReply): void {
@@ -302,7 +302,7 @@ export class EditorState {
     this.pendingDraw = Math.max(this.pendingDraw ?? 0, m.seq);
     const queued = this.normalsQueued[m.slot];
     this.normalsQueued[m.slot] = null;
-    if (queued) this.computeNormals(m.slot, queued);
+    if (queued) this.computeNormals(m.slot, queued.seq, queued.positions);
   }
 
   // Whether a full frame newer than `seq` is already shown or on its way.
@@ -338,7 +338,7 @@ export class EditorState {
     const n = this.rest.length / 3;
     this.viewer.setMesh(this.rest, m.indices, sameTriangles);
     this.post({ kind: 'mesh', slot: 'full', indices: m.indices.slice(), vertices: n });
-    this.computeNormals('full', { seq: this.seq, positions: this.rest } as P.FrameResult);
+    this.computeNormals('full', this.seq, this.rest);
     if (!sameTriangles) {
       // Another mesh: the selection goes (the server says so too), the preview is measured again.
       this.indices = m.indices.slice();
@@ -392,7 +392,7 @@ export class EditorState {
     this.groups = s.groups.map((g) => ({ transform: fromRowMajor(g.transform), pinned: g.pinned }));
     if (this.groups.length === 0) this.groups = [{ transform: new THREE.Matrix4(), pinned: false }];
     this.activeGroup = Math.min(this.activeGroup, this.groups.length - 1);
-    if (!this.hasHandles()) this.computeNormals('full', { seq: this.seq, positions: this.rest } as P.FrameResult);
+    if (!this.hasHandles()) this.computeNormals('full', this.seq, this.rest);
     this.paint();
   }
 
