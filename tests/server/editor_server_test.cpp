@@ -75,14 +75,21 @@ class EditorServerTest : public ::testing::Test {
 
   std::string own_origin() const { return "http://127.0.0.1:" + std::to_string(server_->port()); }
 
-  // Reads messages until a text message of `type` arrives.
-  static nlohmann::json read_until(websocket::stream<tcp::socket>& ws, const std::string& type) {
+  // The next text message.
+  static nlohmann::json next_text(websocket::stream<tcp::socket>& ws) {
     for (;;) {
       beast::flat_buffer buffer;
       ws.read(buffer);
-      if (ws.got_binary()) continue;
-      nlohmann::json j = nlohmann::json::parse(beast::buffers_to_string(buffer.data()));
-      if (j["type"] == type) return j;
+      if (!ws.got_binary()) return nlohmann::json::parse(beast::buffers_to_string(buffer.data()));
+    }
+  }
+
+  // Reads messages until a text message of `type` (or, when `type` is "error", of "ready" after
+  // it) arrives.
+  static nlohmann::json read_until(websocket::stream<tcp::socket>& ws, const std::string& type) {
+    for (;;) {
+      nlohmann::json j = next_text(ws);
+      if (j["type"] == type || (type == "error" && j["type"] == "ready")) return j;
     }
   }
 
@@ -146,6 +153,28 @@ TEST_F(EditorServerTest, ANewWindowTakesOver) {
   boost::system::error_code ec;
   while (!ec) first->read(buffer, ec);
   EXPECT_EQ(ec, websocket::error::closed);
+}
+
+// "cancel" is acted on while the worker computes a basis (it is not queued behind it): the
+// computation's request is answered with a cancelled error, then the settings in force.
+TEST_F(EditorServerTest, CancelStopsABasisComputationAtOnce) {
+  auto ws = connect(own_origin());
+  read_until(*ws, "ready");
+  ws->binary(true);  // a mesh whose basis takes a while: 10242 vertices
+  ws->write(net::buffer(
+      encode_file({"big.obj", encode_mesh(make_icosphere(5), MeshFormat::Obj)}, Tag::MeshFile)));
+  EXPECT_EQ(read_until(*ws, "ready")["vertices"], 10242);
+  ws->text(true);
+  ws->write(net::buffer(std::string(R"({"type":"settings","modes":150})")));
+  EXPECT_TRUE(read_until(*ws, "progress")["cancellable"]);
+  ws->write(net::buffer(std::string(R"({"type":"cancel"})")));
+  // Queued behind the computation instead, the cancel would come too late: "ready" with m = 150.
+  nlohmann::json error;
+  for (nlohmann::json m = read_until(*ws, "error"); m["type"] != "ready"; m = next_text(*ws)) {
+    if (m["type"] == "error") error = m;
+  }
+  EXPECT_EQ(error.value("cancelled", false), true) << error.dump();
+  EXPECT_EQ(error.value("request", ""), "settings");
 }
 
 TEST(EditorServer, ReportsMissingAssetsAndBusyPorts) {
