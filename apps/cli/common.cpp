@@ -78,6 +78,10 @@ void DeformArgs::add_to(CLI::App& cmd) {
          "--anderson", options.arap.anderson_window,
          "ARAP: Anderson acceleration window, 0: none" + fallback(defaults.arap.anderson_window))
       ->check(CLI::Range(0, 20));
+  cmd.add_option("--smoothness", options.arap.rotation_smoothness,
+                 "ARAP: smoothness of the clusters' rotations (bending stiffness)" +
+                     fallback(defaults.arap.rotation_smoothness))
+      ->check(kNonNegative);
   cmd.add_option("--clusters", options.arap.clusters,
                  "ARAP: rotation clusters" + fallback(defaults.arap.clusters))
       ->check(CLI::Range(1, 100000000));
@@ -107,6 +111,7 @@ DeformOptions DeformArgs::merged(const CLI::App& cmd, const DeformOptions& scene
   if (flag("--arap-tolerance")) o.arap.tolerance = options.arap.tolerance;
   if (flag("--anderson")) o.arap.anderson_window = options.arap.anderson_window;
   if (flag("--clusters")) o.arap.clusters = options.arap.clusters;
+  if (flag("--smoothness")) o.arap.rotation_smoothness = options.arap.rotation_smoothness;
   if (flag("--ks")) o.ks = options.ks;
   if (flag("--kb")) o.kb = options.kb;
   if (flag("--weight")) o.constraint_weight = options.constraint_weight;

@@ -19,45 +19,68 @@ namespace {
 
 using Sparse = Eigen::SparseMatrix<double>;
 
-// The rotation R maximising tr(R S), reflections excluded; returns tr(R S).
-double fit_rotation(const Eigen::Matrix3d& S, Eigen::Matrix3d& R) {
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(S, Eigen::ComputeFullU | Eigen::ComputeFullV);
+// The rotation R maximising tr(R X) over all rotations (reflections excluded).
+void fit_rotation(const Eigen::Matrix3d& X, Eigen::Ref<Eigen::Matrix3d> R) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(X, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d V = svd.matrixV();
-  Eigen::Vector3d sigma = svd.singularValues();
-  if ((V * svd.matrixU().transpose()).determinant() < 0) {
-    V.col(2) = -V.col(2);
-    sigma[2] = -sigma[2];
-  }
+  if ((V * svd.matrixU().transpose()).determinant() < 0) V.col(2) = -V.col(2);
   R = V * svd.matrixU().transpose();
-  return sigma.sum();
 }
 
-// An iterate of the local/global loop: x (m x 3 or n x 3), the local step's rotations as the
-// blocks R_k^T - I (3k x 3), and the energy E(x, R).
+// The rotations' part of the energy and its local step. With the covariances S_k (3k x 3) and
+// the cluster graph's weights g_kl (symmetric, zero diagonal),
+//     E_R = -sum_k tr((R_k - I) S_k) + sum_{k < l} g_kl |R_k - R_l|_F^2;
+// fit() replaces each R_k in turn by its minimiser given the others, R_k = argmax
+// tr(R_k (S_k + 2 sum_l g_kl R_l^T)) (one sweep of block coordinate descent, exact without the
+// graph), and returns E_R.
+struct RotationSmoothness {
+  const Sparse& graph;  // k x k
+  double fit(const Eigen::MatrixX3d& S, Eigen::MatrixX3d& R) const {
+    for (Eigen::Index k = 0; k < S.rows() / 3; ++k) {
+      Eigen::Matrix3d X = S.middleRows<3>(3 * k);
+      for (Sparse::InnerIterator it(graph, k); it; ++it)
+        X += 2.0 * it.value() * R.middleRows<3>(3 * it.row()).transpose();
+      fit_rotation(X, R.middleRows<3>(3 * k));
+    }
+    double energy = 0.0;
+    for (Eigen::Index k = 0; k < S.rows() / 3; ++k) {
+      const Eigen::Matrix3d Rk = R.middleRows<3>(3 * k);
+      energy -= ((Rk - Eigen::Matrix3d::Identity()) * S.middleRows<3>(3 * k)).trace();
+      for (Sparse::InnerIterator it(graph, k); it; ++it) {
+        if (it.row() > k) energy += it.value() * (Rk - R.middleRows<3>(3 * it.row())).squaredNorm();
+      }
+    }
+    return energy;
+  }
+};
+
+// An iterate of the local/global loop: x (m x 3 or n x 3), the clusters' rotations R_k (the
+// blocks of 3k x 3) and the energy E(x, R).
 struct Iterate {
   Eigen::MatrixX3d x, rotations;
   double energy = 0.0;
 };
 
+// The blocks R_k^T - I of the global step's right-hand side (3k x 3).
+Eigen::MatrixX3d transposed_minus_identity(const Eigen::MatrixX3d& rotations) {
+  Eigen::MatrixX3d out(rotations.rows(), 3);
+  for (Eigen::Index k = 0; k < rotations.rows(); k += 3)
+    out.middleRows<3>(k) = rotations.middleRows<3>(k).transpose() - Eigen::Matrix3d::Identity();
+  return out;
+}
+
 // The local/global iterations with Anderson acceleration over a space that provides
-// covariance(x) (S, 3k x 3), global(rotations) (the global step's minimiser) and energy(x) (the
-// quadratic and constraint part of E).
+// covariance(x) (S, 3k x 3), global(R^T - I blocks) (the global step's minimiser) and energy(x)
+// (the quadratic and constraint part of E). The local step is a sweep of block coordinate
+// descent over the clusters (exact for the plain ARAP term; with the smoothness term each
+// cluster sees its neighbours' latest rotations), so no step raises the energy.
 template <typename Space>
-Eigen::MatrixX3d iterate(const Space& space, const Eigen::MatrixX3d& start, double scale,
-                         const ArapOptions& options, ArapReport* report) {
-  const auto local = [&](Eigen::MatrixX3d x) {
-    Iterate it;
-    it.x = std::move(x);
+ArapState iterate(const Space& space, const RotationSmoothness& smoothness, ArapState start,
+                  double scale, const ArapOptions& options, ArapReport* report) {
+  const auto local = [&](Eigen::MatrixX3d x, Eigen::MatrixX3d R) {
+    Iterate it{std::move(x), std::move(R), 0.0};
     const Eigen::MatrixX3d S = space.covariance(it.x);
-    it.rotations.resize(S.rows(), 3);
-    double arap = 0.0;  // -sum_k (tr(R_k S_k) - tr(S_k)): E's rotation-dependent part
-    Eigen::Matrix3d R;
-    for (Eigen::Index k = 0; k < S.rows(); k += 3) {
-      const Eigen::Matrix3d Sk = S.middleRows<3>(k);
-      arap -= fit_rotation(Sk, R) - Sk.trace();
-      it.rotations.middleRows<3>(k) = R.transpose() - Eigen::Matrix3d::Identity();
-    }
-    it.energy = space.energy(it.x) + arap;
+    it.energy = space.energy(it.x) + smoothness.fit(S, it.rotations);
     return it;
   };
   // Anderson mixing of the last pairs (G(u_j), G(u_j) - u_j), flattened.
@@ -74,15 +97,15 @@ Eigen::MatrixX3d iterate(const Space& space, const Eigen::MatrixX3d& start, doub
     normal.diagonal().array() += 1e-12 * normal.trace() + 1e-300;
     const Eigen::VectorXd theta = normal.ldlt().solve(dF.transpose() * history.back().second);
     const Eigen::VectorXd u = history.back().first - dG * theta;
-    return Eigen::MatrixX3d(Eigen::Map<const Eigen::MatrixX3d>(u.data(), start.rows(), 3));
+    return Eigen::MatrixX3d(Eigen::Map<const Eigen::MatrixX3d>(u.data(), size / 3, 3));
   };
 
   ArapReport r;
-  Iterate current = local(start);
+  Iterate current = local(std::move(start.x), std::move(start.rotations));
   const double floor = 1e-14 * std::max(current.energy, scale);
   while (r.iterations < options.max_iterations) {
     ++r.iterations;
-    const Eigen::MatrixX3d g = space.global(current.rotations);
+    const Eigen::MatrixX3d g = space.global(transposed_minus_identity(current.rotations));
     if (options.anderson_window > 0) {
       Eigen::VectorXd flat = Eigen::Map<const Eigen::VectorXd>(g.data(), g.size());
       Eigen::VectorXd residual =
@@ -93,13 +116,13 @@ Eigen::MatrixX3d iterate(const Space& space, const Eigen::MatrixX3d& start, doub
     Iterate next;
     bool accelerated = false;
     if (history.size() >= 2) {
-      next = local(mix());
+      next = local(mix(), current.rotations);
       accelerated = next.energy < current.energy;
     }
     if (accelerated) {
       ++r.accelerated;
     } else {
-      next = local(g);
+      next = local(g, current.rotations);
       while (history.size() > 1) history.pop_front();
     }
     r.relative_change = (current.energy - next.energy) / std::max(next.energy, floor);
@@ -111,7 +134,7 @@ Eigen::MatrixX3d iterate(const Space& space, const Eigen::MatrixX3d& start, doub
   }
   r.energy = current.energy;
   if (report != nullptr) *report = r;
-  return current.x;
+  return {std::move(current.x), std::move(current.rotations)};
 }
 
 // The cluster operator over all vertices, 3k x n: column j holds, for the cluster of j,
@@ -148,6 +171,43 @@ Sparse cluster_operator(const Sparse& K, const Vertices& s, const Eigen::VectorX
   return A;
 }
 
+// The weights g_kl of the rotations' smoothness term: beta times the finite-volume weight of
+// the Dirichlet energy on the cluster graph, the length of the boundary between clusters k and
+// l (the lengths of the edges that cross it) over the distance between their centroids.
+Sparse cluster_graph(const Sparse& K, const Vertices& s, const Eigen::VectorXi& label, int clusters,
+                     double beta) {
+  Eigen::MatrixX3d centroid = Eigen::MatrixX3d::Zero(clusters, 3);
+  Eigen::VectorXd size = Eigen::VectorXd::Zero(clusters);
+  for (Eigen::Index i = 0; i < s.rows(); ++i) {
+    centroid.row(label[i]) += s.row(i);
+    size[label[i]] += 1.0;
+  }
+  centroid.array().colwise() /= size.array();
+  std::vector<Eigen::Triplet<double>> boundary;
+  for (int j = 0; j < K.outerSize(); ++j) {
+    for (Sparse::InnerIterator it(K, j); it; ++it) {
+      const int i = static_cast<int>(it.row());
+      if (label[i] != label[j]) {
+        boundary.emplace_back(label[i], label[j], (s.row(i) - s.row(j)).norm());
+      }
+    }
+  }
+  Sparse length(clusters, clusters);  // each crossing edge twice, once per direction
+  length.setFromTriplets(boundary.begin(), boundary.end());
+  std::vector<Eigen::Triplet<double>> weights;
+  for (int l = 0; l < clusters; ++l) {
+    for (Sparse::InnerIterator it(length, l); it; ++it) {
+      const double distance = (centroid.row(it.row()) - centroid.row(l)).norm();
+      if (beta > 0.0 && distance > 0.0) {
+        weights.emplace_back(it.row(), l, 0.5 * beta * it.value() / distance);
+      }
+    }
+  }
+  Sparse graph(clusters, clusters);
+  graph.setFromTriplets(weights.begin(), weights.end());
+  return graph;
+}
+
 }  // namespace
 
 ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
@@ -159,8 +219,11 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
   }
   const VertexClusters clusters = vertex_clusters(TriangleMesh{base, mesh.F}, options.clusters);
   label_ = clusters.label;
-  const Sparse A = cluster_operator(cotan_stiffness(mesh), base, label_, clusters.count);
+  const Sparse K = cotan_stiffness(mesh);
+  const Sparse A = cluster_operator(K, base, label_, clusters.count);
   rest_ = A * base;
+  graph_ = cluster_graph(K, base, label_, clusters.count,
+                         options.rotation_smoothness * surface_area(TriangleMesh{base, mesh.F}));
   // The mean over each cluster's vertices (k x n), applied to the basis when there is one.
   Eigen::VectorXd size = Eigen::VectorXd::Zero(clusters.count);
   for (int i = 0; i < label_.size(); ++i) size[label_[i]] += 1.0;
@@ -198,8 +261,8 @@ Eigen::Vector3d rotation_vector(const Eigen::Matrix3d& linear) {
 // The cold start: each group's rotation spread over the clusters by harmonic weights, then the
 // global step with those rotations.
 template <typename Space>
-Eigen::MatrixX3d propagated_start(const Space& space, const ConstrainedSet& set,
-                                  const std::vector<Eigen::Affine3d>& transforms, int clusters) {
+ArapState propagated_start(const Space& space, const ConstrainedSet& set,
+                           const std::vector<Eigen::Affine3d>& transforms, int clusters) {
   std::vector<Eigen::Vector3d> turn(set.num_groups);
   for (int g = 0; g < set.num_groups; ++g) turn[g] = rotation_vector(transforms[g].linear());
   Eigen::MatrixX3d blended = Eigen::MatrixX3d::Zero(clusters, 3);
@@ -218,15 +281,17 @@ Eigen::MatrixX3d propagated_start(const Space& space, const ConstrainedSet& set,
       for (int j = 0; j < 3 && first + j < set.num_groups; ++j)
         blended.row(k) += std::clamp(weights(k, j), 0.0, 1.0) * turn[first + j].transpose();
   }
-  Eigen::MatrixX3d rotations(3 * clusters, 3);
+  ArapState start;
+  start.rotations.resize(3 * clusters, 3);
   for (int k = 0; k < clusters; ++k) {
     const Eigen::Vector3d w = blended.row(k).transpose();
     const double angle = w.norm();
-    const Eigen::Matrix3d R = angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix()
-                                          : Eigen::Matrix3d::Identity();
-    rotations.middleRows<3>(3 * k) = R.transpose() - Eigen::Matrix3d::Identity();
+    start.rotations.middleRows<3>(3 * k) =
+        angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix()
+                    : Eigen::Matrix3d::Identity();
   }
-  return space.global(rotations);
+  start.x = space.global(transposed_minus_identity(start.rotations));
+  return start;
 }
 
 }  // namespace
@@ -266,34 +331,46 @@ struct ArapSolver::SpatialSpace {
   Eigen::MatrixX3d cluster_means(const Eigen::MatrixX3d& d) const { return self.mean_ * d; }
 };
 
-Eigen::MatrixX3d ArapSolver::start(const ReducedSolver& solver,
-                                   const ReducedSolver::Targets& targets, const ConstrainedSet& set,
-                                   const std::vector<Eigen::Affine3d>& transforms) const {
+ArapState ArapSolver::start(const ReducedSolver& solver, const ReducedSolver::Targets& targets,
+                            const ConstrainedSet& set,
+                            const std::vector<Eigen::Affine3d>& transforms) const {
   if (reduced_.cols() == 0) throw InputError("ARAP: built without a basis");
   return propagated_start(ReducedSpace{*this, solver, targets}, set, transforms, clusters());
 }
 
-Eigen::MatrixX3d ArapSolver::start(const SpatialSolver& solver,
-                                   const SpatialSolver::Targets& targets, const ConstrainedSet& set,
-                                   const std::vector<Eigen::Affine3d>& transforms) const {
+ArapState ArapSolver::start(const SpatialSolver& solver, const SpatialSolver::Targets& targets,
+                            const ConstrainedSet& set,
+                            const std::vector<Eigen::Affine3d>& transforms) const {
   if (operator_.cols() == 0) throw InputError("ARAP: built with a basis");
   return propagated_start(SpatialSpace{*this, solver, targets}, set, transforms, clusters());
 }
 
-Eigen::MatrixX3d ArapSolver::solve(const ReducedSolver& solver,
-                                   const ReducedSolver::Targets& targets,
-                                   const Eigen::MatrixX3d& start, ArapReport* report) const {
+ArapState ArapSolver::solve(const ReducedSolver& solver, const ReducedSolver::Targets& targets,
+                            ArapState start, ArapReport* report) const {
   if (reduced_.cols() == 0) throw InputError("ARAP: built without a basis");
-  return iterate(ReducedSpace{*this, solver, targets}, start, energy_scale(rest_), options_,
+  return iterate(ReducedSpace{*this, solver, targets}, RotationSmoothness{graph_},
+                 checked(std::move(start), reduced_.cols()), energy_scale(rest_), options_, report);
+}
+
+ArapState ArapSolver::solve(const SpatialSolver& solver, const SpatialSolver::Targets& targets,
+                            ArapState start, ArapReport* report) const {
+  if (operator_.cols() == 0) throw InputError("ARAP: built with a basis");
+  return iterate(SpatialSpace{*this, solver, targets}, RotationSmoothness{graph_},
+                 checked(std::move(start), operator_.cols()), energy_scale(rest_), options_,
                  report);
 }
 
-Eigen::MatrixX3d ArapSolver::solve(const SpatialSolver& solver,
-                                   const SpatialSolver::Targets& targets,
-                                   const Eigen::MatrixX3d& start, ArapReport* report) const {
-  if (operator_.cols() == 0) throw InputError("ARAP: built with a basis");
-  return iterate(SpatialSpace{*this, solver, targets}, start, energy_scale(rest_), options_,
-                 report);
+ArapState ArapSolver::checked(ArapState start, Eigen::Index size) const {
+  if (start.x.rows() != size) {
+    throw InputError("ARAP: a start of " + std::to_string(start.x.rows()) + " rows, " +
+                     std::to_string(size) + " expected");
+  }
+  if (start.rotations.rows() != rest_.rows()) {  // none given: the identity
+    start.rotations = Eigen::MatrixX3d(rest_.rows(), 3);
+    for (int k = 0; k < clusters(); ++k)
+      start.rotations.middleRows<3>(3 * k) = Eigen::Matrix3d::Identity();
+  }
+  return start;
 }
 
 }  // namespace specdeform

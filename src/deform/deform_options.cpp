@@ -44,6 +44,8 @@ void DeformOptions::validate() const {
           "the constraint weight must be a finite number > 0");
   require(arap.clusters >= 1, "ARAP needs at least 1 rotation cluster");
   require(arap.max_iterations >= 1, "ARAP needs at least 1 iteration");
+  require(std::isfinite(arap.rotation_smoothness) && arap.rotation_smoothness >= 0,
+          "the ARAP rotation smoothness must be a finite number >= 0");
   require(std::isfinite(arap.tolerance) && arap.tolerance >= 0,
           "the ARAP tolerance must be a finite number >= 0");
   require(arap.anderson_window >= 0 && arap.anderson_window <= 20,

@@ -49,6 +49,7 @@ enum class UnconstrainedPieces {
 // The local/global iterations of DeformEnergy::Arap.
 struct ArapOptions {
   int clusters = 200;        // rotation clusters (at least one per connected component)
+  double rotation_smoothness = 1e-3;  // beta of the rotations' smoothness term (arap_solver.h)
   int max_iterations = 100;  // a cap on the iterations per frame
   double tolerance = 1e-4;   // stop when an iteration lowers the energy by less than this
                              // fraction of the energy's scale (see arap_solver.h)
