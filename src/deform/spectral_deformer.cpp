@@ -31,8 +31,9 @@ class Clock {
 Eigen::VectorXd reduced_hessian(const ManifoldHarmonics& basis, double area,
                                 const DeformOptions& options) {
   const Eigen::ArrayXd lambda = basis.eigenvalues.array().max(0.0);
-  if (options.energy == DeformEnergy::Arap) return lambda.matrix();
-  return (options.ks * lambda + options.kb * area * lambda.square()).matrix();
+  const bool arap = options.energy == DeformEnergy::Arap;
+  const double ks = arap ? 1.0 : options.ks, kb = arap ? options.arap.bending : options.kb;
+  return (ks * lambda + kb * area * lambda.square()).matrix();
 }
 
 }  // namespace

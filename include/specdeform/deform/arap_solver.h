@@ -48,7 +48,7 @@ namespace specdeform {
 
 struct ArapReport {
   int iterations = 0;            // local/global steps taken
-  int accelerated = 0;           // of which Anderson steps kept
+  int accelerated = 0;           // of which quasi-Newton (L-BFGS) steps kept
   double energy = 0.0;           // at the result
   double relative_change = 0.0;  // the last step's decrease of the energy over the energy
   bool converged = false;        // stopped by the tolerance, not by the cap
@@ -99,10 +99,9 @@ class ArapSolver {
   Eigen::VectorXi label_;
   // Over all vertices: the cluster operator (3k x n) and the mean over each cluster (k x n).
   Eigen::SparseMatrix<double> operator_, mean_;
-  // Spectral: the same applied to the basis, Q = operator_ H (3k x m) and mean_ H (k x m).
-  Eigen::MatrixXd reduced_, reduced_mean_;
-  Eigen::MatrixX3d rest_;              // S(s), 3k x 3
-  Eigen::SparseMatrix<double> graph_;  // the smoothness weights g_kl, k x k
+  // Spectral: the same applied to the basis, Q = operator_ H (3k x m), Q^T and mean_ H (k x m).
+  Eigen::MatrixXd reduced_, reduced_transposed_, reduced_mean_;
+  Eigen::MatrixX3d rest_;  // S(s), 3k x 3
 };
 
 }  // namespace specdeform
