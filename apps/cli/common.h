@@ -92,6 +92,7 @@ void add_demo_command(CLI::App& app);
 void add_deform_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_converge_command(CLI::App& app);
+void add_compare_command(CLI::App& app);
 void add_edit_command(CLI::App& app);
 
 }  // namespace specdeform::cli
