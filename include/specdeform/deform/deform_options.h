@@ -59,7 +59,7 @@ struct ArapOptions {
 };
 
 struct DeformOptions {
-  DeformEnergy energy = DeformEnergy::Linear;
+  DeformEnergy energy = DeformEnergy::Arap;  // measured: docs/results.md, "Rotations"
   double ks = 0.0;  // Linear: stretching weight
   double kb = 1.0;  // Linear: bending weight
   ArapOptions arap;
