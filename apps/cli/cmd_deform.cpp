@@ -91,6 +91,7 @@ void add_deform_command(CLI::App& app) {
       j["energy"] = name(options.energy);
       if (options.energy == DeformEnergy::Arap) {
         j["iterations"] = arap.iterations;
+        j["quasi_newton_steps"] = arap.accelerated;
         j["relative_energy_change"] = arap.relative_change;
         j["tolerance"] = options.arap.tolerance;
         j["converged"] = arap.converged;

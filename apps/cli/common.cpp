@@ -74,10 +74,12 @@ void DeformArgs::add_to(CLI::App& cmd) {
                  "ARAP: stop when an iteration lowers the energy by less than this fraction" +
                      fallback(defaults.arap.tolerance))
       ->check(kNonNegative);
-  cmd.add_option(
-         "--anderson", options.arap.anderson_window,
-         "ARAP: Anderson acceleration window, 0: none" + fallback(defaults.arap.anderson_window))
-      ->check(CLI::Range(0, 20));
+  cmd.add_option("--history", options.arap.history,
+                 "ARAP: L-BFGS pairs kept, 0: plain local/global" + fallback(defaults.arap.history))
+      ->check(CLI::Range(0, 50));
+  cmd.add_option("--arap-bending", options.arap.bending,
+                 "ARAP: bending weight against the membrane's 1" + fallback(defaults.arap.bending))
+      ->check(kNonNegative);
   cmd.add_option("--clusters", options.arap.clusters,
                  "ARAP: rotation clusters" + fallback(defaults.arap.clusters))
       ->check(CLI::Range(1, 100000000));
@@ -105,8 +107,9 @@ DeformOptions DeformArgs::merged(const CLI::App& cmd, const DeformOptions& scene
   if (flag("--energy")) o.energy = options.energy;
   if (flag("--iterations")) o.arap.max_iterations = options.arap.max_iterations;
   if (flag("--arap-tolerance")) o.arap.tolerance = options.arap.tolerance;
-  if (flag("--anderson")) o.arap.anderson_window = options.arap.anderson_window;
+  if (flag("--history")) o.arap.history = options.arap.history;
   if (flag("--clusters")) o.arap.clusters = options.arap.clusters;
+  if (flag("--arap-bending")) o.arap.bending = options.arap.bending;
   if (flag("--ks")) o.ks = options.ks;
   if (flag("--kb")) o.kb = options.kb;
   if (flag("--weight")) o.constraint_weight = options.constraint_weight;

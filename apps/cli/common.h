@@ -21,7 +21,7 @@ extern const CLI::Validator kPositive;
 // Accepts a number >= 0.
 extern const CLI::Validator kNonNegative;
 
-// The deformation settings' flags: --energy, --iterations, --arap-tolerance, --anderson,
+// The deformation settings' flags: --energy, --iterations, --arap-tolerance, --history,
 // --clusters, --ks, --kb, --weight, --detail, --solver, --constraints. merged(): a scene's settings
 // where no flag was given.
 struct DeformArgs {
@@ -92,6 +92,7 @@ void add_demo_command(CLI::App& app);
 void add_deform_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_converge_command(CLI::App& app);
+void add_compare_command(CLI::App& app);
 void add_edit_command(CLI::App& app);
 
 }  // namespace specdeform::cli

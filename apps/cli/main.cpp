@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   specdeform::cli::add_deform_command(app);
   specdeform::cli::add_bench_command(app);
   specdeform::cli::add_converge_command(app);
+  specdeform::cli::add_compare_command(app);
   specdeform::cli::add_demo_command(app);
   specdeform::cli::add_edit_command(app);
   try {

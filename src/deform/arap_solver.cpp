@@ -6,12 +6,15 @@
 #include <vector>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
+#include "linalg/basis_product.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/vertex_clusters.h"
 #include "specdeform/operators/cotan_laplacian.h"
+#include "specdeform/operators/mass_matrix.h"
 
 namespace specdeform {
 
@@ -19,88 +22,127 @@ namespace {
 
 using Sparse = Eigen::SparseMatrix<double>;
 
-// The rotation R maximising tr(R S), reflections excluded; returns tr(R S).
-double fit_rotation(const Eigen::Matrix3d& S, Eigen::Matrix3d& R) {
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(S, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d V = svd.matrixV();
-  Eigen::Vector3d sigma = svd.singularValues();
-  if ((V * svd.matrixU().transpose()).determinant() < 0) {
-    V.col(2) = -V.col(2);
-    sigma[2] = -sigma[2];
+// The rotation R maximising tr(R X) over all rotations (reflections excluded): the polar factor
+// of Z = X^T with the reflection removed, R = U diag(1, 1, det(U V^T)) V^T for Z = U S V^T. V and
+// S^2 come from the closed-form eigen-decomposition of Z^T Z, u_i = Z v_i / s_i for the two
+// largest s_i, u_3 = u_1 x u_2 and v_3 = v_1 x v_2 (no division by the smallest singular value,
+// and the right orientation by construction): 2-3 times faster than a Jacobi SVD, as accurate.
+// Where Z has rank below 2 the Jacobi SVD decides.
+void fit_rotation(const Eigen::Matrix3d& X, Eigen::Ref<Eigen::Matrix3d> R) {
+  const Eigen::Matrix3d Z = X.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+  eigen.computeDirect(X * Z);  // Z^T Z, ascending eigenvalues
+  const Eigen::Vector3d v1 = eigen.eigenvectors().col(2);
+  const Eigen::Vector3d v2 =
+      (eigen.eigenvectors().col(1) - v1.dot(eigen.eigenvectors().col(1)) * v1).normalized();
+  const Eigen::Vector3d u1 = (Z * v1).normalized();
+  Eigen::Vector3d u2 = Z * v2;
+  u2 -= u1.dot(u2) * u1;
+  const double scale = Z.norm();
+  if (u2.norm() > 1e-9 * scale && std::isfinite(u2.norm())) {
+    u2.normalize();
+    Eigen::Matrix3d U, V;
+    U << u1, u2, u1.cross(u2);
+    V << v1, v2, v1.cross(v2);
+    R = U * V.transpose();
+    return;
   }
-  R = V * svd.matrixU().transpose();
-  return sigma.sum();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(Z, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d U = svd.matrixU();
+  if ((U * svd.matrixV().transpose()).determinant() < 0) U.col(2) = -U.col(2);
+  R = U * svd.matrixV().transpose();
 }
 
-// An iterate of the local/global loop: x (m x 3 or n x 3), the local step's rotations as the
-// blocks R_k^T - I (3k x 3), and the energy E(x, R).
+// The local step: each R_k maximises tr(R_k S_k) given the covariances S (3k x 3, blocks S_k),
+// from R's previous value where the fit iterates. Returns the energy's rotation-dependent part,
+// -sum_k tr((R_k - I) S_k).
+double fit_rotations(const Eigen::MatrixX3d& S, Eigen::MatrixX3d& R) {
+  double energy = 0.0;
+  for (Eigen::Index k = 0; k < S.rows(); k += 3) {
+    const Eigen::Matrix3d Sk = S.middleRows<3>(k);
+    fit_rotation(Sk, R.middleRows<3>(k));
+    energy -= ((R.middleRows<3>(k) - Eigen::Matrix3d::Identity()) * Sk).trace();
+  }
+  return energy;
+}
+
+// An iterate: x (m x 3 or n x 3), the clusters' rotations R_k (the blocks of 3k x 3), the
+// energy E(x, R) and half its gradient in x.
 struct Iterate {
-  Eigen::MatrixX3d x, rotations;
+  Eigen::MatrixX3d x, rotations, gradient;  // gradient: half of E's, for these rotations
   double energy = 0.0;
 };
 
-// The local/global iterations with Anderson acceleration over a space that provides
-// covariance(x) (S, 3k x 3), global(rotations) (the global step's minimiser) and energy(x) (the
-// quadratic and constraint part of E).
+// The blocks R_k^T - I of the global step's right-hand side (3k x 3).
+Eigen::MatrixX3d transposed_minus_identity(const Eigen::MatrixX3d& rotations) {
+  Eigen::MatrixX3d out(rotations.rows(), 3);
+  for (Eigen::Index k = 0; k < rotations.rows(); k += 3)
+    out.middleRows<3>(k) = rotations.middleRows<3>(k).transpose() - Eigen::Matrix3d::Identity();
+  return out;
+}
+
+// The minimisation of E(x) = min_R E(x, R) over a space that provides covariance(x) (S, 3k x 3),
+// energy(x, R^T - I blocks, &gradient) (E's quadratic and constraint part, and half of E's
+// gradient in x with the rotations optimal for x: the envelope theorem) and precondition(v) (the
+// inverse of the quadratic part's Hessian: the global step is x - precondition(gradient)).
+// L-BFGS (Liu, Bouaziz & Kavan, "Quasi-Newton methods for real-time simulation of hyperelastic
+// materials", 2017) with the global step's matrix as the initial inverse Hessian: without
+// history its step is the local/global step. A step that fails the Armijo condition is replaced
+// by the local/global step, which never raises the energy, and the history is cleared.
 template <typename Space>
-Eigen::MatrixX3d iterate(const Space& space, const Eigen::MatrixX3d& start, double scale,
-                         const ArapOptions& options, ArapReport* report) {
-  const auto local = [&](Eigen::MatrixX3d x) {
-    Iterate it;
-    it.x = std::move(x);
-    const Eigen::MatrixX3d S = space.covariance(it.x);
-    it.rotations.resize(S.rows(), 3);
-    double arap = 0.0;  // -sum_k (tr(R_k S_k) - tr(S_k)): E's rotation-dependent part
-    Eigen::Matrix3d R;
-    for (Eigen::Index k = 0; k < S.rows(); k += 3) {
-      const Eigen::Matrix3d Sk = S.middleRows<3>(k);
-      arap -= fit_rotation(Sk, R) - Sk.trace();
-      it.rotations.middleRows<3>(k) = R.transpose() - Eigen::Matrix3d::Identity();
-    }
-    it.energy = space.energy(it.x) + arap;
+ArapState iterate(const Space& space, ArapState start, double scale, const ArapOptions& options,
+                  ArapReport* report) {
+  const auto local = [&](Eigen::MatrixX3d x, Eigen::MatrixX3d R) {
+    Iterate it{std::move(x), std::move(R), {}, 0.0};
+    const double rotational = fit_rotations(space.covariance(it.x), it.rotations);
+    it.energy =
+        space.energy(it.x, transposed_minus_identity(it.rotations), &it.gradient) + rotational;
     return it;
   };
-  // Anderson mixing of the last pairs (G(u_j), G(u_j) - u_j), flattened.
-  std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> history;
-  const auto mix = [&]() {
-    const Eigen::Index p = static_cast<Eigen::Index>(history.size()) - 1;
-    const Eigen::Index size = history.back().first.size();
-    Eigen::MatrixXd dF(size, p), dG(size, p);
-    for (Eigen::Index j = 0; j < p; ++j) {
-      dF.col(j) = history[j + 1].second - history[j].second;
-      dG.col(j) = history[j + 1].first - history[j].first;
-    }
-    Eigen::MatrixXd normal = dF.transpose() * dF;
-    normal.diagonal().array() += 1e-12 * normal.trace() + 1e-300;
-    const Eigen::VectorXd theta = normal.ldlt().solve(dF.transpose() * history.back().second);
-    const Eigen::VectorXd u = history.back().first - dG * theta;
-    return Eigen::MatrixX3d(Eigen::Map<const Eigen::MatrixX3d>(u.data(), start.rows(), 3));
+  const auto dot = [](const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
+    return (a.array() * b.array()).sum();
   };
-
+  struct Pair {
+    Eigen::MatrixX3d step, change;  // x_{i+1} - x_i, gradient_{i+1} - gradient_i
+    double rho;                     // 1 / (change . step)
+  };
+  std::deque<Pair> history;
   ArapReport r;
-  Iterate current = local(start);
+  Iterate current = local(std::move(start.x), std::move(start.rotations));
   const double floor = 1e-14 * std::max(current.energy, scale);
+  std::vector<double> alpha;
   while (r.iterations < options.max_iterations) {
     ++r.iterations;
-    const Eigen::MatrixX3d g = space.global(current.rotations);
-    if (options.anderson_window > 0) {
-      Eigen::VectorXd flat = Eigen::Map<const Eigen::VectorXd>(g.data(), g.size());
-      Eigen::VectorXd residual =
-          flat - Eigen::Map<const Eigen::VectorXd>(current.x.data(), current.x.size());
-      history.emplace_back(std::move(flat), std::move(residual));
-      if (static_cast<int>(history.size()) > options.anderson_window + 1) history.pop_front();
+    Eigen::MatrixX3d direction = current.gradient;  // the two-loop recursion
+    alpha.resize(history.size());
+    for (size_t i = history.size(); i-- > 0;) {
+      alpha[i] = history[i].rho * dot(history[i].step, direction);
+      direction -= alpha[i] * history[i].change;
+    }
+    direction = space.precondition(direction);
+    for (size_t i = 0; i < history.size(); ++i) {
+      direction +=
+          (alpha[i] - history[i].rho * dot(history[i].change, direction)) * history[i].step;
     }
     Iterate next;
-    bool accelerated = false;
-    if (history.size() >= 2) {
-      next = local(mix());
-      accelerated = next.energy < current.energy;
+    const double slope = -2.0 * dot(current.gradient, direction);  // of E along -direction
+    bool accepted = false;
+    if (!history.empty() && slope < 0.0) {
+      next = local(current.x - direction, current.rotations);
+      accepted = next.energy <= current.energy + 1e-4 * slope;
     }
-    if (accelerated) {
+    if (accepted) {
       ++r.accelerated;
     } else {
-      next = local(g);
-      while (history.size() > 1) history.pop_front();
+      next = local(current.x - space.precondition(current.gradient), current.rotations);
+      history.clear();
+    }
+    Pair pair{next.x - current.x, next.gradient - current.gradient, 0.0};
+    const double curvature = dot(pair.change, pair.step);
+    if (options.history > 0 && curvature > 0.0) {
+      pair.rho = 1.0 / curvature;
+      history.push_back(std::move(pair));
+      if (static_cast<int>(history.size()) > options.history) history.pop_front();
     }
     r.relative_change = (current.energy - next.energy) / std::max(next.energy, floor);
     current = std::move(next);
@@ -111,7 +153,7 @@ Eigen::MatrixX3d iterate(const Space& space, const Eigen::MatrixX3d& start, doub
   }
   r.energy = current.energy;
   if (report != nullptr) *report = r;
-  return current.x;
+  return {std::move(current.x), std::move(current.rotations)};
 }
 
 // The cluster operator over all vertices, 3k x n: column j holds, for the cluster of j,
@@ -148,6 +190,26 @@ Sparse cluster_operator(const Sparse& K, const Vertices& s, const Eigen::VectorX
   return A;
 }
 
+// The bending part of the covariance operator, 3k x n: with l_i = (M^-1 K s)_i, the rest
+// shape's mean-curvature normal at vertex i (M the lumped mass), cluster k's rows of B s' are
+// sum_{i in k} l_i (K s')_i^T.
+Sparse bending_operator(const Sparse& K, const Eigen::VectorXd& mass, const Vertices& s,
+                        const Eigen::VectorXi& label, int clusters) {
+  const Eigen::MatrixX3d curvature = mass.cwiseInverse().asDiagonal() * (K * s);
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(3 * static_cast<size_t>(K.nonZeros()));
+  for (int j = 0; j < K.outerSize(); ++j) {
+    for (Sparse::InnerIterator it(K, j); it; ++it) {  // K_ij, i = it.row()
+      const int i = static_cast<int>(it.row());
+      for (int d = 0; d < 3; ++d)
+        entries.emplace_back(3 * label[i] + d, j, curvature(i, d) * it.value());
+    }
+  }
+  Sparse B(3 * clusters, K.cols());
+  B.setFromTriplets(entries.begin(), entries.end());
+  return B;
+}
+
 }  // namespace
 
 ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
@@ -159,7 +221,12 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
   }
   const VertexClusters clusters = vertex_clusters(TriangleMesh{base, mesh.F}, options.clusters);
   label_ = clusters.label;
-  const Sparse A = cluster_operator(cotan_stiffness(mesh), base, label_, clusters.count);
+  const Sparse K = cotan_stiffness(mesh);
+  const Eigen::VectorXd mass = lumped_mass(mesh);
+  // Membrane and bending, as the linear energy's ks = 1 and kb = bending (unit-area scale).
+  const Sparse A = cluster_operator(K, base, label_, clusters.count) +
+                   (2.0 * options.bending * mass.sum()) *
+                       bending_operator(K, mass, base, label_, clusters.count);
   rest_ = A * base;
   // The mean over each cluster's vertices (k x n), applied to the basis when there is one.
   Eigen::VectorXd size = Eigen::VectorXd::Zero(clusters.count);
@@ -170,6 +237,7 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
   cluster_mean.setFromTriplets(mean.begin(), mean.end());
   if (basis) {
     reduced_ = A * basis->basis;
+    reduced_transposed_ = reduced_.transpose();
     reduced_mean_ = cluster_mean * basis->basis;
   } else {
     operator_ = A;
@@ -198,8 +266,8 @@ Eigen::Vector3d rotation_vector(const Eigen::Matrix3d& linear) {
 // The cold start: each group's rotation spread over the clusters by harmonic weights, then the
 // global step with those rotations.
 template <typename Space>
-Eigen::MatrixX3d propagated_start(const Space& space, const ConstrainedSet& set,
-                                  const std::vector<Eigen::Affine3d>& transforms, int clusters) {
+ArapState propagated_start(const Space& space, const ConstrainedSet& set,
+                           const std::vector<Eigen::Affine3d>& transforms, int clusters) {
   std::vector<Eigen::Vector3d> turn(set.num_groups);
   for (int g = 0; g < set.num_groups; ++g) turn[g] = rotation_vector(transforms[g].linear());
   Eigen::MatrixX3d blended = Eigen::MatrixX3d::Zero(clusters, 3);
@@ -218,15 +286,17 @@ Eigen::MatrixX3d propagated_start(const Space& space, const ConstrainedSet& set,
       for (int j = 0; j < 3 && first + j < set.num_groups; ++j)
         blended.row(k) += std::clamp(weights(k, j), 0.0, 1.0) * turn[first + j].transpose();
   }
-  Eigen::MatrixX3d rotations(3 * clusters, 3);
+  ArapState start;
+  start.rotations.resize(3 * clusters, 3);
   for (int k = 0; k < clusters; ++k) {
     const Eigen::Vector3d w = blended.row(k).transpose();
     const double angle = w.norm();
-    const Eigen::Matrix3d R = angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix()
-                                          : Eigen::Matrix3d::Identity();
-    rotations.middleRows<3>(3 * k) = R.transpose() - Eigen::Matrix3d::Identity();
+    start.rotations.middleRows<3>(3 * k) =
+        angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix()
+                    : Eigen::Matrix3d::Identity();
   }
-  return space.global(rotations);
+  start.x = space.global(transposed_minus_identity(start.rotations));
+  return start;
 }
 
 }  // namespace
@@ -238,13 +308,27 @@ struct ArapSolver::ReducedSpace {
   const ArapSolver& self;
   const ReducedSolver& solver;
   const ReducedSolver::Targets& targets;
+  // Q c and 1/2 Q^T r with the frame's vectorised kernel (no BLAS call: its threads would spin
+  // beside the frame's own).
   Eigen::MatrixX3d covariance(const Eigen::MatrixX3d& c) const {
-    return self.rest_ + self.reduced_.lazyProduct(c);
+    Eigen::MatrixX3d S;
+    detail::add_basis_product(self.rest_, self.reduced_, c, S);
+    return S;
+  }
+  Eigen::MatrixX3d linear_term(const Eigen::MatrixX3d& rotations) const {
+    Eigen::MatrixX3d g;
+    detail::add_basis_product(Eigen::MatrixX3d::Zero(self.reduced_.cols(), 3),
+                              self.reduced_transposed_, 0.5 * rotations, g);
+    return g;
   }
   Eigen::MatrixX3d global(const Eigen::MatrixX3d& rotations) const {
-    return solver.solve(targets, 0.5 * self.reduced_.transpose().lazyProduct(rotations));
+    return solver.solve(targets, linear_term(rotations));
   }
-  double energy(const Eigen::MatrixX3d& c) const { return solver.energy(targets, c); }
+  double energy(const Eigen::MatrixX3d& c, const Eigen::MatrixX3d& rotations,
+                Eigen::MatrixX3d* gradient) const {
+    return solver.energy(targets, c, linear_term(rotations), gradient);
+  }
+  Eigen::MatrixX3d precondition(const Eigen::MatrixX3d& v) const { return solver.precondition(v); }
   Eigen::MatrixX3d harmonic(const Eigen::MatrixX3d& values) const { return solver.solve(values); }
   Eigen::MatrixX3d cluster_means(const Eigen::MatrixX3d& c) const {
     return self.reduced_mean_.lazyProduct(c);
@@ -261,39 +345,54 @@ struct ArapSolver::SpatialSpace {
   Eigen::MatrixX3d global(const Eigen::MatrixX3d& rotations) const {
     return solver.solve(targets, 0.5 * (self.operator_.transpose() * rotations));
   }
-  double energy(const Eigen::MatrixX3d& d) const { return solver.energy(targets, d); }
+  double energy(const Eigen::MatrixX3d& d, const Eigen::MatrixX3d& rotations,
+                Eigen::MatrixX3d* gradient) const {
+    return solver.energy(targets, d, 0.5 * (self.operator_.transpose() * rotations), gradient);
+  }
+  Eigen::MatrixX3d precondition(const Eigen::MatrixX3d& v) const { return solver.precondition(v); }
   Eigen::MatrixX3d harmonic(const Eigen::MatrixX3d& values) const { return solver.solve(values); }
   Eigen::MatrixX3d cluster_means(const Eigen::MatrixX3d& d) const { return self.mean_ * d; }
 };
 
-Eigen::MatrixX3d ArapSolver::start(const ReducedSolver& solver,
-                                   const ReducedSolver::Targets& targets, const ConstrainedSet& set,
-                                   const std::vector<Eigen::Affine3d>& transforms) const {
+ArapState ArapSolver::start(const ReducedSolver& solver, const ReducedSolver::Targets& targets,
+                            const ConstrainedSet& set,
+                            const std::vector<Eigen::Affine3d>& transforms) const {
   if (reduced_.cols() == 0) throw InputError("ARAP: built without a basis");
   return propagated_start(ReducedSpace{*this, solver, targets}, set, transforms, clusters());
 }
 
-Eigen::MatrixX3d ArapSolver::start(const SpatialSolver& solver,
-                                   const SpatialSolver::Targets& targets, const ConstrainedSet& set,
-                                   const std::vector<Eigen::Affine3d>& transforms) const {
+ArapState ArapSolver::start(const SpatialSolver& solver, const SpatialSolver::Targets& targets,
+                            const ConstrainedSet& set,
+                            const std::vector<Eigen::Affine3d>& transforms) const {
   if (operator_.cols() == 0) throw InputError("ARAP: built with a basis");
   return propagated_start(SpatialSpace{*this, solver, targets}, set, transforms, clusters());
 }
 
-Eigen::MatrixX3d ArapSolver::solve(const ReducedSolver& solver,
-                                   const ReducedSolver::Targets& targets,
-                                   const Eigen::MatrixX3d& start, ArapReport* report) const {
+ArapState ArapSolver::solve(const ReducedSolver& solver, const ReducedSolver::Targets& targets,
+                            ArapState start, ArapReport* report) const {
   if (reduced_.cols() == 0) throw InputError("ARAP: built without a basis");
-  return iterate(ReducedSpace{*this, solver, targets}, start, energy_scale(rest_), options_,
-                 report);
+  return iterate(ReducedSpace{*this, solver, targets}, checked(std::move(start), reduced_.cols()),
+                 energy_scale(rest_), options_, report);
 }
 
-Eigen::MatrixX3d ArapSolver::solve(const SpatialSolver& solver,
-                                   const SpatialSolver::Targets& targets,
-                                   const Eigen::MatrixX3d& start, ArapReport* report) const {
+ArapState ArapSolver::solve(const SpatialSolver& solver, const SpatialSolver::Targets& targets,
+                            ArapState start, ArapReport* report) const {
   if (operator_.cols() == 0) throw InputError("ARAP: built with a basis");
-  return iterate(SpatialSpace{*this, solver, targets}, start, energy_scale(rest_), options_,
-                 report);
+  return iterate(SpatialSpace{*this, solver, targets}, checked(std::move(start), operator_.cols()),
+                 energy_scale(rest_), options_, report);
+}
+
+ArapState ArapSolver::checked(ArapState start, Eigen::Index size) const {
+  if (start.x.rows() != size) {
+    throw InputError("ARAP: a start of " + std::to_string(start.x.rows()) + " rows, " +
+                     std::to_string(size) + " expected");
+  }
+  if (start.rotations.rows() != rest_.rows()) {  // none given: the identity
+    start.rotations = Eigen::MatrixX3d(rest_.rows(), 3);
+    for (int k = 0; k < clusters(); ++k)
+      start.rotations.middleRows<3>(3 * k) = Eigen::Matrix3d::Identity();
+  }
+  return start;
 }
 
 }  // namespace specdeform

@@ -44,10 +44,11 @@ void DeformOptions::validate() const {
           "the constraint weight must be a finite number > 0");
   require(arap.clusters >= 1, "ARAP needs at least 1 rotation cluster");
   require(arap.max_iterations >= 1, "ARAP needs at least 1 iteration");
+  require(std::isfinite(arap.bending) && arap.bending >= 0,
+          "the ARAP bending weight must be a finite number >= 0");
   require(std::isfinite(arap.tolerance) && arap.tolerance >= 0,
           "the ARAP tolerance must be a finite number >= 0");
-  require(arap.anderson_window >= 0 && arap.anderson_window <= 20,
-          "the Anderson window must be in [0, 20]");
+  require(arap.history >= 0 && arap.history <= 50, "the ARAP history must be in [0, 50]");
 }
 
 std::string_view name(DeformEnergy energy) {

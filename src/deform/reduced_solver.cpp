@@ -5,6 +5,7 @@
 #include <Eigen/LU>
 #include <Eigen/QR>
 
+#include "linalg/basis_product.h"
 #include "specdeform/exceptions.h"
 
 namespace specdeform {
@@ -137,13 +138,29 @@ Eigen::MatrixX3d ReducedSolver::solve(const Targets& targets, const Eigen::Matri
   return c;
 }
 
-double ReducedSolver::energy(const Targets& targets, const Eigen::MatrixX3d& c) const {
-  if (options_.constraints == ConstraintMode::Hard) {
-    return (c.array().square().colwise() * hessian_.array()).sum();
+double ReducedSolver::energy(const Targets& targets, const Eigen::MatrixX3d& c,
+                             const Eigen::MatrixX3d& g, Eigen::MatrixX3d* gradient) const {
+  const bool hard = options_.constraints == ConstraintMode::Hard;
+  // The Hessian's product Nc (soft: the normal matrix D + w H_C^T W H_C; hard: D).
+  Eigen::MatrixX3d Nc;
+  if (hard) {
+    Nc = hessian_.asDiagonal() * c;
+  } else {
+    detail::add_basis_product(Eigen::MatrixX3d::Zero(c.rows(), 3), normal_, c, Nc);
   }
-  // D + w H_C^T W H_C is the normal matrix: tr(c^T N c) - 2 tr(c^T rhs) + constant.
-  const Eigen::MatrixX3d Nc = normal_.lazyProduct(c);  // no BLAS call, as above
+  if (gradient != nullptr) {
+    *gradient = hard ? Nc : Eigen::MatrixX3d(Nc - targets.rhs);
+    if (g.rows() != 0) *gradient -= g;
+  }
+  if (hard) return (c.array() * Nc.array()).sum();
   return (c.array() * (Nc - 2.0 * targets.rhs).array()).sum() + targets.constant;
+}
+
+Eigen::MatrixX3d ReducedSolver::precondition(const Eigen::MatrixX3d& v) const {
+  if (options_.constraints == ConstraintMode::Hard) return hard_free_.lazyProduct(v);
+  Eigen::MatrixX3d out = v;
+  for (int d = 0; d < 3; ++d) out.col(d) = soft_.solve(out.col(d));
+  return out;
 }
 
 }  // namespace specdeform

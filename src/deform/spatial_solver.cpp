@@ -21,12 +21,10 @@ SpatialSolver::SpatialSolver(const TriangleMesh& mesh, const DeformOptions& opti
     throw InputError("spatial solver: some vertices have zero area (only degenerate faces)");
   }
   vertex_area_ = mass / area;
-  if (options.energy == DeformEnergy::Arap) {
-    A_ = K;
-  } else {
-    const Eigen::SparseMatrix<double> Dinv_K = mass.cwiseInverse().asDiagonal() * K;
-    A_ = options.ks * K + (options.kb * area) * Eigen::SparseMatrix<double>(K * Dinv_K);
-  }
+  const bool arap = options.energy == DeformEnergy::Arap;
+  const double ks = arap ? 1.0 : options.ks, kb = arap ? options.arap.bending : options.kb;
+  const Eigen::SparseMatrix<double> Dinv_K = mass.cwiseInverse().asDiagonal() * K;
+  A_ = ks * K + (kb * area) * Eigen::SparseMatrix<double>(K * Dinv_K);
   A_.makeCompressed();
 }
 
@@ -113,15 +111,34 @@ Eigen::MatrixX3d SpatialSolver::solve(const Targets& targets, const Eigen::Matri
   return d;
 }
 
-double SpatialSolver::energy(const Targets& targets, const Eigen::MatrixX3d& d) const {
-  double e = (d.array() * (A_ * d).array()).sum();
+double SpatialSolver::energy(const Targets& targets, const Eigen::MatrixX3d& d,
+                             const Eigen::MatrixX3d& g, Eigen::MatrixX3d* gradient) const {
+  const Eigen::MatrixX3d Ad = A_ * d;
+  double e = (d.array() * Ad.array()).sum();
+  if (gradient != nullptr) {
+    *gradient = Ad;
+    if (g.rows() != 0) *gradient -= g;
+  }
   if (options_.constraints == ConstraintMode::Soft) {
     for (size_t i = 0; i < constrained_.size(); ++i) {
-      e += options_.constraint_weight * vertex_area_[constrained_[i]] *
-           (d.row(constrained_[i]) - targets.values.row(i)).squaredNorm();
+      const int v = constrained_[i];
+      const double w = options_.constraint_weight * vertex_area_[v];
+      const Eigen::RowVector3d miss = d.row(v) - targets.values.row(i);
+      e += w * miss.squaredNorm();
+      if (gradient != nullptr) gradient->row(v) += w * miss;
     }
   }
   return e;
+}
+
+Eigen::MatrixX3d SpatialSolver::precondition(const Eigen::MatrixX3d& v) const {
+  if (options_.constraints == ConstraintMode::Soft) return factor_->llt.solve(v);
+  Eigen::MatrixX3d free(free_.size(), 3);
+  for (size_t i = 0; i < free_.size(); ++i) free.row(i) = v.row(free_[i]);
+  free = factor_->llt.solve(free);
+  Eigen::MatrixX3d out = Eigen::MatrixX3d::Zero(v.rows(), 3);
+  for (size_t i = 0; i < free_.size(); ++i) out.row(free_[i]) = free.row(i);
+  return out;
 }
 
 }  // namespace specdeform

@@ -31,8 +31,9 @@ class Clock {
 Eigen::VectorXd reduced_hessian(const ManifoldHarmonics& basis, double area,
                                 const DeformOptions& options) {
   const Eigen::ArrayXd lambda = basis.eigenvalues.array().max(0.0);
-  if (options.energy == DeformEnergy::Arap) return lambda.matrix();
-  return (options.ks * lambda + options.kb * area * lambda.square()).matrix();
+  const bool arap = options.energy == DeformEnergy::Arap;
+  const double ks = arap ? 1.0 : options.ks, kb = arap ? options.arap.bending : options.kb;
+  return (ks * lambda + kb * area * lambda.square()).matrix();
 }
 
 }  // namespace
@@ -113,36 +114,38 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
   // ARAP starts from the handles' rotations spread over the surface, or from the last frame
   // when asked to.
   const Eigen::Index size = reduced_ ? basis_->basis.cols() : mesh_.num_vertices();
-  const bool warm = options_.arap.warm_start && solution_.rows() == size;
+  const bool warm = options_.arap.warm_start && state_.x.rows() == size;
   arap_report_ = ArapReport{};
   arap_report_.converged = true;
   if (reduced_) {
     const ReducedSolver::Targets targets = reduced_->prepare(displacement_targets);
     if (arap_) {
-      const Eigen::MatrixX3d start =
-          warm ? solution_ : arap_->start(*reduced_, targets, constrained_, transforms);
-      solution_ = arap_->solve(*reduced_, targets, start, &arap_report_);
+      state_ = arap_->solve(
+          *reduced_, targets,
+          warm ? std::move(state_) : arap_->start(*reduced_, targets, constrained_, transforms),
+          &arap_report_);
     } else {
-      solution_ = reduced_->solve(targets, Eigen::MatrixX3d());
+      state_.x = reduced_->solve(targets, Eigen::MatrixX3d());
     }
     frame_.reduced_solve = clock.lap();
     if (options_.float32_basis) {
-      detail::add_basis_product(base_, basis32_, solution_, deformed_base_);
+      detail::add_basis_product(base_, basis32_, state_.x, deformed_base_);
     } else {
-      detail::add_basis_product(base_, basis_->basis, solution_, deformed_base_);
+      detail::add_basis_product(base_, basis_->basis, state_.x, deformed_base_);
     }
     frame_.inverse_transform = clock.lap();
   } else {
     const SpatialSolver::Targets targets = spatial_->prepare(displacement_targets);
     if (arap_) {
-      const Eigen::MatrixX3d start =
-          warm ? solution_ : arap_->start(*spatial_, targets, constrained_, transforms);
-      solution_ = arap_->solve(*spatial_, targets, start, &arap_report_);
+      state_ = arap_->solve(
+          *spatial_, targets,
+          warm ? std::move(state_) : arap_->start(*spatial_, targets, constrained_, transforms),
+          &arap_report_);
     } else {
-      solution_ = spatial_->solve(targets, Eigen::MatrixX3d());
+      state_.x = spatial_->solve(targets, Eigen::MatrixX3d());
     }
     frame_.reduced_solve = clock.lap();
-    deformed_base_ = base_ + solution_;
+    deformed_base_ = base_ + state_.x;
     frame_.inverse_transform = clock.lap();
   }
   // Held pieces stay exactly where they are (the solvers hold them only as well as soft

@@ -91,6 +91,40 @@ TriangleMesh make_bumpy_bar(const BumpyBarOptions& o) {
   return from_lists(points, tris);
 }
 
+TriangleMesh make_bumpy_tube(const BumpyTubeOptions& o) {
+  if (o.length <= 0 || o.radius <= 0 || o.segments < 3 || o.cells_per_unit < 1) {
+    throw InputError(
+        "bumpy tube: length, radius, cells_per_unit and segments (>= 3) must be "
+        "positive");
+  }
+  const int rings = std::max(1, static_cast<int>(std::lround(o.length * o.cells_per_unit))) + 1;
+  const int bumps_along = static_cast<int>(std::lround(o.bumps_per_unit * o.length));
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < rings; ++i) {
+    const double x = o.length * i / (rings - 1);
+    for (int a = 0; a < o.segments; ++a) {
+      const double angle = 2 * kPi * a / o.segments;
+      const double s = std::sin(kPi * bumps_along * i / (rings - 1));
+      const double t = std::sin(0.5 * o.bumps_around * angle);
+      const double r = o.radius + o.bump_height * s * s * t * t;
+      points.emplace_back(x, r * std::cos(angle), r * std::sin(angle));
+    }
+  }
+  const int first = static_cast<int>(points.size()), last = first + 1;
+  points.emplace_back(0.0, 0.0, 0.0);
+  points.emplace_back(o.length, 0.0, 0.0);
+  std::vector<std::array<int, 3>> tris;
+  const auto id = [&](int i, int a) { return i * o.segments + (a % o.segments); };
+  for (int i = 0; i + 1 < rings; ++i)
+    for (int a = 0; a < o.segments; ++a)
+      add_quad(tris, id(i, a), id(i, a + 1), id(i + 1, a + 1), id(i + 1, a));
+  for (int a = 0; a < o.segments; ++a) {
+    tris.push_back({first, id(0, a + 1), id(0, a)});
+    tris.push_back({last, id(rings - 1, a), id(rings - 1, a + 1)});
+  }
+  return from_lists(points, tris);
+}
+
 TriangleMesh make_bumpy_plane(const BumpyPlaneOptions& o) {
   if (o.size <= 0 || o.resolution < 1) {
     throw InputError("bumpy plane: size and resolution must be positive");

@@ -49,16 +49,17 @@ enum class UnconstrainedPieces {
 // The local/global iterations of DeformEnergy::Arap.
 struct ArapOptions {
   int clusters = 200;        // rotation clusters (at least one per connected component)
+  double bending = 1e-3;     // the bending weight against the membrane's 1 (arap_solver.h)
   int max_iterations = 100;  // a cap on the iterations per frame
   double tolerance = 1e-4;   // stop when an iteration lowers the energy by less than this
                              // fraction of the energy's scale (see arap_solver.h)
-  int anderson_window = 5;   // previous iterates Anderson acceleration mixes; 0: none
+  int history = 5;           // L-BFGS pairs kept; 0: plain local/global steps
   bool warm_start = false;   // start from the previous frame's solution instead of the rest
                              // pose (interactive drags; not for timing a cold frame)
 };
 
 struct DeformOptions {
-  DeformEnergy energy = DeformEnergy::Linear;
+  DeformEnergy energy = DeformEnergy::Arap;  // measured: docs/results.md, "Rotations"
   double ks = 0.0;  // Linear: stretching weight
   double kb = 1.0;  // Linear: bending weight
   ArapOptions arap;

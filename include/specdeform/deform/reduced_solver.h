@@ -52,8 +52,16 @@ class ReducedSolver {
   }
 
   // E(c) without the linear term: tr(c^T D c) plus, soft, the constraint term (hard: c is taken
-  // to meet the constraints).
-  double energy(const Targets& targets, const Eigen::MatrixX3d& c) const;
+  // to meet the constraints). With `gradient`, also half of E's gradient at c for the linear term
+  // g (m x 3): soft, (D + w H_C^T W_C H_C) c - rhs - g; hard, D c - g.
+  double energy(const Targets& targets, const Eigen::MatrixX3d& c,
+                const Eigen::MatrixX3d& g = Eigen::MatrixX3d(),
+                Eigen::MatrixX3d* gradient = nullptr) const;
+
+  // The inverse of E's Hessian applied to v (soft: the normal matrix's inverse; hard: restricted
+  // to the directions that keep the constraints): solve() is c - precondition(gradient) from any
+  // c (that meets the hard constraints).
+  Eigen::MatrixX3d precondition(const Eigen::MatrixX3d& v) const;
 
   const Eigen::VectorXd& hessian() const { return hessian_; }
 

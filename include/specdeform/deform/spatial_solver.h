@@ -46,8 +46,14 @@ class SpatialSolver {
     return solve(prepare(targets), Eigen::MatrixX3d());
   }
 
-  // E(d) without the linear term: tr(d^T A d) plus, soft, the constraint term.
-  double energy(const Targets& targets, const Eigen::MatrixX3d& d) const;
+  // E(d) without the linear term: tr(d^T A d) plus, soft, the constraint term; with `gradient`,
+  // also half of E's gradient at d for the linear term g (n x 3), as in ReducedSolver.
+  double energy(const Targets& targets, const Eigen::MatrixX3d& d,
+                const Eigen::MatrixX3d& g = Eigen::MatrixX3d(),
+                Eigen::MatrixX3d* gradient = nullptr) const;
+
+  // The inverse of E's Hessian applied to v (hard: zero on the constrained vertices).
+  Eigen::MatrixX3d precondition(const Eigen::MatrixX3d& v) const;
 
   // The energy's matrix A (n x n), on the unit-area scale.
   const Eigen::SparseMatrix<double>& energy_matrix() const { return A_; }

@@ -109,7 +109,8 @@ class SpectralDeformer {
   Eigen::VectorXi components_;  // connected component of each vertex
   int num_components_ = 0;
   ConstrainedSet constrained_;
-  Eigen::MatrixX3d solution_;        // c (spectral) or d (spatial) of the last solve
+  ArapState state_;                  // c (spectral) or d (spatial) of the last solve, and
+                                     // ARAP's rotations
   Eigen::MatrixX3d detail_targets_;  // targets of the last solve, for constraint_error
   ArapReport arap_report_;
   SetupTimings setup_;

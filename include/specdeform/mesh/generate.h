@@ -20,6 +20,20 @@ struct BumpyBarOptions {
 };
 TriangleMesh make_bumpy_bar(const BumpyBarOptions& options = {});
 
+// A round bar (a tube with closed ends) along x, x in [0, length], radius `radius`, its side
+// covered with smooth bumps (sin^2 along x and around) pushed outwards, the ends closed by fans
+// around a centre vertex. Closed; segments x (length * cells_per_unit + 1) + 2 vertices.
+struct BumpyTubeOptions {
+  double length = 6.0;
+  double radius = 0.5;
+  int segments = 48;          // vertices around each ring
+  int cells_per_unit = 24;    // rings per unit length
+  int bumps_per_unit = 3;     // bumps per unit length
+  int bumps_around = 6;       // bumps around the tube
+  double bump_height = 0.03;  // absolute height of a bump
+};
+TriangleMesh make_bumpy_tube(const BumpyTubeOptions& options = {});
+
 // The unit square [0, size] x [0, size] in the plane z = 0, resolution x resolution cells,
 // with bumps z = bump_height sin^2(pi k x / size) sin^2(pi k y / size), k = bumps per side.
 // bump_height = 0 gives the flat square (free boundary) of the analytic spectrum tests.
