@@ -166,7 +166,8 @@ class SpectralDeformer:
         iterations: int = ...,
         clusters: int = ...,
         arap_tolerance: float = ...,
-        anderson_window: int = ...,
+        history: int = ...,
+        arap_bending: float = ...,
         warm_start: bool = ...,
     ) -> None: ...
     def set_selection(

@@ -130,7 +130,7 @@ the basis is computed here. With solver="spatial" and no basis, the base is the 
 Keywords: the deformation options (energy="linear"|"arap", ks, kb, constraint_weight,
 detail="none"|"displacement"|"frames"|"transfer", solver="spectral"|"spatial",
 constraints="soft"|"hard", unconstrained="keep"|"error", float32_basis, and for ARAP
-iterations, clusters, arap_tolerance, anderson_window, warm_start).)")
+iterations, clusters, arap_tolerance, arap_bending, history, warm_start).)")
       .def(
           "set_selection",
           [](Deformer& d, py::handle handles, py::handle fixed) {
@@ -224,7 +224,7 @@ vertices held in place. A vertex may belong to one group only.)")
             py::dict r;
             r["energy"] = std::string(name(d.deformer->options().energy));
             r["iterations"] = a.iterations;
-            r["accelerated"] = a.accelerated;
+            r["quasi_newton_steps"] = a.accelerated;
             r["arap_energy"] = a.energy;
             r["relative_change"] = a.relative_change;
             r["converged"] = a.converged;
@@ -232,7 +232,7 @@ vertices held in place. A vertex may belong to one group only.)")
             r["held_pieces"] = d.deformer->held_pieces();
             return r;
           },
-          R"(The last solve: ARAP's iterations (Anderson steps kept: accelerated), its energy
+          R"(The last solve: ARAP's iterations (of which L-BFGS steps: quasi_newton_steps), its energy
 and last relative change, whether it converged (the linear energy: 0 iterations, converged),
 the rotation clusters, and held_pieces (components without a handle or fixed vertex, held in
 place by the last selection).)");

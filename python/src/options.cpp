@@ -52,7 +52,8 @@ const std::map<std::string, Setter>& setters() {
       {"iterations", [](auto& o, auto v, auto& k) { o.arap.max_iterations = integer(v, k); }},
       {"clusters", [](auto& o, auto v, auto& k) { o.arap.clusters = integer(v, k); }},
       {"arap_tolerance", [](auto& o, auto v, auto& k) { o.arap.tolerance = number(v, k); }},
-      {"anderson_window", [](auto& o, auto v, auto& k) { o.arap.anderson_window = integer(v, k); }},
+      {"history", [](auto& o, auto v, auto& k) { o.arap.history = integer(v, k); }},
+      {"arap_bending", [](auto& o, auto v, auto& k) { o.arap.bending = number(v, k); }},
       {"warm_start", [](auto& o, auto v, auto& k) { o.arap.warm_start = boolean(v, k); }},
   };
   return table;
@@ -89,7 +90,8 @@ py::dict to_dict(const DeformOptions& o) {
   d["iterations"] = o.arap.max_iterations;
   d["clusters"] = o.arap.clusters;
   d["arap_tolerance"] = o.arap.tolerance;
-  d["anderson_window"] = o.arap.anderson_window;
+  d["history"] = o.arap.history;
+  d["arap_bending"] = o.arap.bending;
   d["warm_start"] = o.arap.warm_start;
   return d;
 }

@@ -1,6 +1,6 @@
 // DeformOptions as Python keyword arguments, one per field, named as on the command line and in
 // scene files: energy, ks, kb, constraint_weight, detail, solver, constraints, unconstrained,
-// float32_basis, and ARAP's iterations, clusters, arap_tolerance, anderson_window, warm_start.
+// float32_basis, and ARAP's iterations, clusters, arap_tolerance, arap_bending, history, warm_start.
 #pragma once
 
 #include <pybind11/pybind11.h>

@@ -298,7 +298,7 @@ def test_bad_selections_and_transforms(bar, call, message):
         ({"clusters": 2.5}, "clusters: expected an integer, got float"),
         ({"ks": 0.0, "kb": 0.0}, "not both 0"),
         ({"constraint_weight": -1.0}, "constraint weight"),
-        ({"anderson_window": 50}, "Anderson window"),
+        ({"history": 51}, "history"),
         ({"mass": "diagonal"}, "mass"),
     ],
 )
