@@ -157,7 +157,7 @@ void EditorSession::handle(bool binary, std::string_view message) {
 std::optional<std::string> EditorSession::start(LoadedMesh mesh, std::string name) {
   request_ = "open";
   if (answer([&] { open(std::move(mesh), std::move(name)); })) return std::nullopt;
-  if (!state_) send_(false, dump({{"type", "empty"}}));
+  if (!state_) send_(false, dump({{"type", "empty"}, {"request", request_}}));
   return last_error_;
 }
 
@@ -238,7 +238,8 @@ void EditorSession::text_message(std::string_view message) {
   const std::string type = j["type"];
   request_ = type;
   if (type == "open_demo") return open(demo_mesh(), kDemoName);
-  if (type == "hello" && !state_) return send_(false, dump({{"type", "empty"}}));
+  if (type == "hello" && !state_)
+    return send_(false, dump({{"type", "empty"}, {"request", request_}}));
   if (type == "cancel") return;  // nothing runs: there is nothing to cancel
   if (!state_) throw InputError("no mesh is open");
   State& s = *state_;
@@ -633,6 +634,7 @@ void EditorSession::send_state() {
                       {"transform", matrix(s.edit.transforms[g])}});
   }
   send_(false, dump({{"type", "state"},
+                     {"request", request_},
                      {"groups", groups},
                      {"fixed", s.edit.selection.fixed.size()},
                      {"undo", s.at > 0},
@@ -665,7 +667,7 @@ void EditorSession::solve_and_send(bool preview) {
   const FrameView view{s.base_view, preview && s.preview.has_value()};
   const PreviewMesh* coarse = s.preview ? &*s.preview : nullptr;
   if (!s.has_handles) {
-    return send_(true, encode_frame_result(s.seq, view, {}, s.rest(), coarse));
+    return send_(true, encode_frame_result(s.seq, view, {}, s.rest(), s.rest(), coarse));
   }
   SpectralDeformer& deformer = view.preview ? *s.sketch : *s.deformer;
   Vertices shown = deformer.solve(s.edit.transforms);
@@ -687,7 +689,7 @@ void EditorSession::solve_and_send(bool preview) {
   const Vertices& positions = view.preview  ? shown
                               : s.base_view ? s.deformer->deformed_base()
                                             : s.result;
-  send_(true, encode_frame_result(s.seq, view, stats, positions, coarse));
+  send_(true, encode_frame_result(s.seq, view, stats, positions, s.rest(), coarse));
 }
 
 }  // namespace specdeform::server

@@ -22,10 +22,11 @@
 //     {"type": "ready", "name", "vertices", "faces", "diagonal", "mesh_id", "modes", "settings",
 //      "pose", "basis": {"seconds", "source": "computed|cache|reused", "residual", "warning"},
 //      "setup": {...}, "arap_clusters"}         after a mesh message or a settings request
-//     {"type": "state", "groups": [{"vertices", "pinned", "transform": 16 numbers}], "fixed",
+//     {"type": "state", "request": the request's type ("open": the server's first mesh),
+//      "groups": [{"vertices", "pinned", "transform": 16 numbers}], "fixed",
 //      "undo", "redo", "selection_seconds", "pin_error", "held_pieces", "pose"}
 //                                               after every edit, last (its frame comes first)
-//     {"type": "empty"}                         no mesh is open (a failed or cancelled start)
+//     {"type": "empty", "request"}              no mesh is open (a failed or cancelled start)
 //     {"type": "error", "message": one line, "request": the request's type, "cancelled": b}
 // Every request is answered: by its reply (ready, state, file, preview, a frame), or by an
 // error naming the request, after which nothing has changed; a rejected setting is followed by

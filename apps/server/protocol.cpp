@@ -1,5 +1,6 @@
 #include "protocol.h"
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 
@@ -231,11 +232,21 @@ std::string encode_preview(const PreviewMesh& preview) {
 }
 
 std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& stats,
-                                const Vertices& positions, const PreviewMesh* preview) {
+                                const Vertices& positions, const Vertices& rest,
+                                const PreviewMesh* preview) {
   const bool subset = view.preview && preview != nullptr;
   const size_t n = subset ? preview->vertices.size() : static_cast<size_t>(positions.rows());
+  const auto vertex = [&](size_t i) {
+    return subset ? preview->vertices[i] : static_cast<Eigen::Index>(i);
+  };
+  double largest = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    largest =
+        std::max(largest, (positions.row(vertex(i)) - rest.row(vertex(i))).cwiseAbs().maxCoeff());
+  }
+  const float scale = largest > 0.0 ? static_cast<float>(largest / 32767.0) : 1.0f;
   Writer w;
-  w.reserve(48 + 12 * n);
+  w.reserve(52 + 6 * n + 2);
   w.put(static_cast<uint32_t>(Tag::FrameResult));
   w.put(seq);
   w.put(static_cast<uint32_t>(n));
@@ -247,11 +258,35 @@ std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& 
   w.put(static_cast<float>(stats.error_rms));
   w.put(static_cast<uint32_t>(stats.arap_iterations));
   w.put(uint32_t{stats.arap_converged ? 1u : 0u});
+  w.put(scale);
   for (size_t i = 0; i < n; ++i) {
-    const Eigen::Index v = subset ? preview->vertices[i] : static_cast<Eigen::Index>(i);
-    for (int k = 0; k < 3; ++k) w.put(static_cast<float>(positions(v, k)));
+    for (int k = 0; k < 3; ++k) {
+      const double d = (positions(vertex(i), k) - rest(vertex(i), k)) / scale;
+      w.put(static_cast<int16_t>(std::clamp(std::lround(d), -32767L, 32767L)));
+    }
   }
+  w.align4();
   return w.take();
+}
+
+Vertices decode_frame_positions(std::string_view message, const Vertices& rest,
+                                const PreviewMesh* preview) {
+  Reader r(message, "frame result");
+  r.bytes(8);
+  const uint32_t n = r.get<uint32_t>(), view = r.get<uint32_t>();
+  const bool subset = (view & 2) != 0;
+  if (subset && (preview == nullptr || preview->vertices.size() != n)) r.fail("not this preview's");
+  if (!subset && n != rest.rows()) r.fail("not this mesh's");
+  r.bytes(32);
+  const float scale = r.get<float>();
+  Vertices out(n, 3);
+  for (uint32_t i = 0; i < n; ++i) {
+    const Eigen::Index v = subset ? preview->vertices[i] : i;
+    for (int k = 0; k < 3; ++k) out(i, k) = rest(v, k) + scale * r.get<int16_t>();
+  }
+  r.align4();
+  r.expect_end();
+  return out;
 }
 
 }  // namespace specdeform::server

@@ -22,12 +22,18 @@
 //                  f32 reduced solve, inverse transform, detail, total (ms) |
 //                  f32 constraint error max, rms (over the bounding-box diagonal) |
 //                  u32 ARAP iterations | u32 1 if ARAP converged (or the energy is linear) |
-//                  f32 positions (3 n; a preview: of the preview's vertices, in its order)
+//                  f32 scale | i16 displacements (3 n, then zeros to a multiple of 4 bytes):
+//                  position = rest position + scale * displacement, of all vertices or of the
+//                  preview's, in its order (a quarter of float32 positions' size; the step is
+//                  the largest displacement / 32767)
 //   103 file       the layout of 3: an export for the browser to save
 //   104 selection  the layout of 1 (no fit flags): the server's selection and transforms, for
 //                  the browser to adopt (after a reload, an undo, a selection file or a scene)
 //   105 preview    u32 tag | u32 k | u32 triangles T | u32 mesh vertex of each preview vertex
 //                  (k) | u32 corners (3 T, preview numbering): a coarse view for drags
+// Half a step (the largest displacement / 65534) is below the display's resolution and below
+// 1e-5 of the bounding-box diagonal for displacements up to a third of it; exports are
+// written by the server in double precision.
 // Text (JSON objects with a "type"): see editor_session.h.
 #pragma once
 
@@ -119,8 +125,13 @@ std::string encode_frame(const FrameRequest& frame);
 std::string encode_file(const NamedFile& file, Tag tag = Tag::File);
 std::string encode_mesh_message(const TriangleMesh& mesh);
 std::string encode_preview(const PreviewMesh& preview);
-// `positions`: the whole mesh's; a preview view sends those of `preview`'s vertices.
+// `positions` and `rest`: the whole mesh's; a preview view sends `preview`'s vertices.
 std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& stats,
-                                const Vertices& positions, const PreviewMesh* preview = nullptr);
+                                const Vertices& positions, const Vertices& rest,
+                                const PreviewMesh* preview = nullptr);
+// The positions a frame result carries (the preview's vertices' for a preview), from the rest
+// positions of the whole mesh. Throws InputError for a message of another length.
+Vertices decode_frame_positions(std::string_view message, const Vertices& rest,
+                                const PreviewMesh* preview = nullptr);
 
 }  // namespace specdeform::server

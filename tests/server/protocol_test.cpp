@@ -101,9 +101,12 @@ TEST(Protocol, MeshAndFrameResultLayouts) {
   const std::string mesh = encode_mesh_message(m);
   EXPECT_EQ(mesh.size(), 12u + 36u + 12u);
   EXPECT_EQ(message_tag(mesh), Tag::Mesh);
+  Vertices moved = m.V;
+  moved(1, 0) += 0.5;
+  moved(2, 2) -= 0.25;
   const std::string frame =
-      encode_frame_result(9, {true, false}, {0.001, 0, 0, 0.002, 1e-6, 1e-7, 7, false}, m.V);
-  EXPECT_EQ(frame.size(), 48u + 36u);
+      encode_frame_result(9, {true, false}, {0.001, 0, 0, 0.002, 1e-6, 1e-7, 7, false}, moved, m.V);
+  EXPECT_EQ(frame.size(), 52u + 20u);  // 9 displacements of 2 bytes, padded to 4
   float total_ms = 0;
   std::memcpy(&total_ms, frame.data() + 28, 4);
   EXPECT_FLOAT_EQ(total_ms, 2.0f);
@@ -112,19 +115,20 @@ TEST(Protocol, MeshAndFrameResultLayouts) {
   std::memcpy(&converged, frame.data() + 44, 4);
   EXPECT_EQ(iterations, 7u);
   EXPECT_EQ(converged, 0u);
-  float x1 = 0;
-  std::memcpy(&x1, frame.data() + 48 + 12, 4);
-  EXPECT_EQ(x1, 1.0f);
+  // Positions within half a step (the largest displacement / 32767) of the sent ones.
+  EXPECT_LT((decode_frame_positions(frame, m.V) - moved).cwiseAbs().maxCoeff(),
+            0.5 / 32767 * 0.5 + 1e-7);
+  EXPECT_THROW(decode_frame_positions(frame.substr(0, 60), m.V), InputError);
   // A preview frame carries the preview's vertices only, in its order.
   const PreviewMesh preview{{2, 1}, Faces(0, 3)};
-  const std::string coarse = encode_frame_result(3, {false, true}, {}, m.V, &preview);
-  EXPECT_EQ(coarse.size(), 48u + 24u);
+  const std::string coarse = encode_frame_result(3, {false, true}, {}, moved, m.V, &preview);
+  EXPECT_EQ(coarse.size(), 52u + 12u);
   uint32_t view = 0;
   std::memcpy(&view, coarse.data() + 12, 4);
   EXPECT_EQ(view, 2u);
-  float y0 = 0;
-  std::memcpy(&y0, coarse.data() + 48 + 4, 4);
-  EXPECT_EQ(y0, 1.0f);  // vertex 2's y
+  const Vertices back = decode_frame_positions(coarse, m.V, &preview);
+  EXPECT_NEAR(back(0, 2), moved(2, 2), 0.5 / 32767);
+  EXPECT_NEAR(back(1, 0), moved(1, 0), 0.5 / 32767);
   EXPECT_EQ(encode_preview(preview).size(), 12u + 8u);
   EXPECT_THROW(message_tag("ab"), InputError);
 }

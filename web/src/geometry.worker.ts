@@ -1,5 +1,5 @@
-// Off the main thread: vertex normals of every frame (of the full mesh and of the coarse
-// preview) and the brush (the vertices within a radius, along the surface or in space), so that
+// Off the main thread: the positions of every frame from its 16-bit displacements, their
+// vertex normals (of the full mesh and of the coarse preview), and the brush (the vertices within a radius, along the surface or in space), so that
 // the page keeps taking pointer events while a large mesh is processed.
 import { Brush } from './brush';
 import { vertexNormals } from './normals';
@@ -7,18 +7,19 @@ import { vertexNormals } from './normals';
 export type Slot = 'full' | 'preview';
 
 export type WorkerRequest =
-  | { kind: 'mesh'; slot: Slot; indices: Uint32Array; vertices: number }
-  | { kind: 'normals'; slot: Slot; seq: number; positions: Float32Array }
+  | { kind: 'mesh'; slot: Slot; indices: Uint32Array; rest: Float32Array }
+  | { kind: 'frame'; slot: Slot; seq: number; scale: number; displacements: Int16Array }
   | { kind: 'brush'; id: number; vertex: number; center: [number, number, number]; radius: number; geodesic: boolean };
 
 export type WorkerReply =
-  | { kind: 'normals'; slot: Slot; seq: number; positions: Float32Array; normals: Float32Array }
+  | { kind: 'frame'; slot: Slot; seq: number; positions: Float32Array; normals: Float32Array }
   | { kind: 'brush'; id: number; vertices: Uint32Array };
 
 interface Mesh {
   indices: Uint32Array;
+  rest: Float32Array;
   brush: Brush | null;
-  positions: Float32Array; // the last positions given (the brush measures on them)
+  positions: Float32Array; // the last frame's (the brush measures on them)
 }
 
 const meshes: Partial<Record<Slot, Mesh>> = {};
@@ -30,16 +31,20 @@ self.onmessage = (e: MessageEvent<WorkerRequest>) => {
   if (m.kind === 'mesh') {
     meshes[m.slot] = {
       indices: m.indices,
-      brush: m.slot === 'full' ? new Brush(m.vertices, m.indices) : null,
-      positions: new Float32Array(3 * m.vertices),
+      rest: m.rest,
+      brush: m.slot === 'full' ? new Brush(m.rest.length / 3, m.indices) : null,
+      positions: m.rest.slice(),
     };
-  } else if (m.kind === 'normals') {
+  } else if (m.kind === 'frame') {
     const mesh = meshes[m.slot];
-    if (!mesh || mesh.positions.length !== m.positions.length) return;
-    mesh.positions.set(m.positions);
-    const normals = new Float32Array(m.positions.length);
-    vertexNormals(m.positions, mesh.indices, normals);
-    post({ kind: 'normals', slot: m.slot, seq: m.seq, positions: m.positions, normals }, [m.positions.buffer, normals.buffer]);
+    if (!mesh || mesh.rest.length !== m.displacements.length) return;
+    const { rest, positions } = mesh;
+    const d = m.displacements;
+    for (let i = 0; i < d.length; ++i) positions[i] = rest[i] + m.scale * d[i];
+    const normals = new Float32Array(positions.length);
+    vertexNormals(positions, mesh.indices, normals);
+    const copy = positions.slice();
+    post({ kind: 'frame', slot: m.slot, seq: m.seq, positions: copy, normals }, [copy.buffer, normals.buffer]);
   } else {
     const mesh = meshes.full;
     if (!mesh?.brush) return;

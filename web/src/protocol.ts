@@ -60,6 +60,7 @@ export interface ReadyMessage {
 
 export interface StateMessage {
   type: 'state';
+  request: string; // the request it answers ("open": the server's first mesh, unrequested)
   groups: { vertices: number; pinned: boolean; transform: Matrix }[];
   fixed: number;
   undo: boolean;
@@ -77,7 +78,7 @@ export interface ErrorMessage {
   cancelled: boolean;
 }
 
-export type ServerText = ProgressMessage | ReadyMessage | StateMessage | ErrorMessage | { type: 'empty' };
+export type ServerText = ProgressMessage | ReadyMessage | StateMessage | ErrorMessage | { type: 'empty'; request: string };
 
 // ---------------------------------------------------------------- JSON, browser -> server
 
@@ -114,7 +115,10 @@ export interface FrameResult {
   ms: { reducedSolve: number; inverseTransform: number; detail: number; total: number };
   error: { max: number; rms: number };
   arap: { iterations: number; converged: boolean };
-  positions: Float32Array;
+  // Positions are rest positions + scale * displacements (of the preview's vertices for a
+  // preview): 16 bits a coordinate.
+  scale: number;
+  displacements: Int16Array; // 3 n
 }
 
 export interface NamedFile {
@@ -221,6 +225,7 @@ export function decodeFrameResult(buffer: ArrayBuffer): FrameResult {
     ms: { reducedSolve: f[0], inverseTransform: f[1], detail: f[2], total: f[3] },
     error: { max: f[4], rms: f[5] },
     arap: { iterations: u[10], converged: u[11] === 1 },
-    positions: new Float32Array(buffer, 48, 3 * u[2]),
+    scale: new Float32Array(buffer, 48, 1)[0],
+    displacements: new Int16Array(buffer, 52, 3 * u[2]),
   };
 }

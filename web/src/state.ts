@@ -55,6 +55,7 @@ export class EditorState {
   notes: Note[] = [];
   drawMs = 0; // the full mesh's draw time
   previewWanted = false;
+  private preview: P.PreviewMessage | null = null; // the coarse mesh of drags
   painting = false; // a brush stroke is on (interaction.ts)
   discardFrames = false; // count frame results without drawing them (measuring the server)
   private listeners: (() => void)[] = [];
@@ -230,7 +231,7 @@ export class EditorState {
         if (this.phase.kind !== 'busy' || this.phase.expects !== 'file') this.phase = { kind: 'ready' };
         break;
       case 'empty':
-        this.awaitingStates = Math.max(0, this.awaitingStates - 1);
+        if (STATE_REQUESTS.has(m.request)) this.awaitingStates = Math.max(0, this.awaitingStates - 1);
         this.phase = { kind: 'empty' };
         this.ready = null;
         break;
@@ -251,8 +252,8 @@ export class EditorState {
       case P.Tag.Preview: {
         const p = P.decodePreview(buffer);
         this.viewer.setPreview(p.vertices, p.indices);
-        this.post({ kind: 'mesh', slot: 'preview', indices: p.indices.slice(), vertices: p.vertices.length });
-        return;
+        this.preview = { vertices: p.vertices.slice(), indices: p.indices.slice() };
+        return this.postPreview(this.preview);
       }
       case P.Tag.FrameResult: {
         const r = P.decodeFrameResult(buffer);
@@ -264,7 +265,7 @@ export class EditorState {
         this.frame = r;
         const slot: Slot = r.preview ? 'preview' : 'full';
         if (this.normalsBusy[slot]) this.normalsQueued[slot] = r; // latest wins
-        else this.computeNormals(slot, r.seq, r.positions);
+        else this.computeFrame(slot, r.seq, r.scale, r.displacements);
         return;
       }
       case P.Tag.File: {
@@ -282,11 +283,16 @@ export class EditorState {
     }
   }
 
-  private computeNormals(slot: Slot, seq: number, positions: Float32Array): void {
+  // The worker makes the positions and their normals (a copy of the displacements goes: the
+  // message's buffer holds other fields too).
+  private computeFrame(slot: Slot, seq: number, scale: number, displacements: Int16Array): void {
     this.normalsBusy[slot] = true;
-    // A copy goes to the worker and comes back with its normals (the message's buffer holds
-    // other fields too).
-    this.post({ kind: 'normals', slot, seq, positions: positions.slice() }, true);
+    this.post({ kind: 'frame', slot, seq, scale, displacements: displacements.slice() });
+  }
+
+  // The rest shape, as a frame without displacements.
+  private showRest(): void {
+    this.computeFrame('full', this.seq, 1, new Int16Array(this.rest.length));
   }
 
   private onWorker(m: WorkerReply): void {
@@ -302,7 +308,7 @@ export class EditorState {
     this.pendingDraw = Math.max(this.pendingDraw ?? 0, m.seq);
     const queued = this.normalsQueued[m.slot];
     this.normalsQueued[m.slot] = null;
-    if (queued) this.computeNormals(m.slot, queued.seq, queued.positions);
+    if (queued) this.computeFrame(m.slot, queued.seq, queued.scale, queued.displacements);
   }
 
   // Whether a full frame newer than `seq` is already shown or on its way.
@@ -311,8 +317,14 @@ export class EditorState {
     return (f !== null && f.seq > seq) || (!this.viewer.showingPreview && this.lastDrawn > seq);
   }
 
-  private post(request: WorkerRequest, transfer = false): void {
-    const buffers = request.kind === 'normals' && transfer ? [request.positions.buffer] : [];
+  private postPreview(p: P.PreviewMessage): void {
+    const rest = new Float32Array(3 * p.vertices.length);
+    p.vertices.forEach((v, i) => rest.set(this.rest.subarray(3 * v, 3 * v + 3), 3 * i));
+    this.post({ kind: 'mesh', slot: 'preview', indices: p.indices.slice(), rest });
+  }
+
+  private post(request: WorkerRequest): void {
+    const buffers = request.kind === 'frame' ? [request.displacements.buffer] : [];
     this.worker.postMessage(request, buffers);
   }
 
@@ -337,8 +349,9 @@ export class EditorState {
     this.rest = m.positions.slice();
     const n = this.rest.length / 3;
     this.viewer.setMesh(this.rest, m.indices, sameTriangles);
-    this.post({ kind: 'mesh', slot: 'full', indices: m.indices.slice(), vertices: n });
-    this.computeNormals('full', this.seq, this.rest);
+    this.post({ kind: 'mesh', slot: 'full', indices: m.indices.slice(), rest: this.rest.slice() });
+    this.showRest();
+    if (sameTriangles && this.preview) this.postPreview(this.preview); // another pose
     if (!sameTriangles) {
       // Another mesh: the selection goes (the server says so too), the preview is measured again.
       this.indices = m.indices.slice();
@@ -346,6 +359,7 @@ export class EditorState {
       this.groups = [{ transform: new THREE.Matrix4(), pinned: false }];
       this.activeGroup = 0;
       this.previewWanted = false;
+      this.preview = null;
       this.drawMs = 0;
       this.paint();
     }
@@ -392,12 +406,12 @@ export class EditorState {
     this.groups = s.groups.map((g) => ({ transform: fromRowMajor(g.transform), pinned: g.pinned }));
     if (this.groups.length === 0) this.groups = [{ transform: new THREE.Matrix4(), pinned: false }];
     this.activeGroup = Math.min(this.activeGroup, this.groups.length - 1);
-    if (!this.hasHandles()) this.computeNormals('full', this.seq, this.rest);
+    if (!this.hasHandles()) this.showRest();
     this.paint();
   }
 
   private adoptState(m: P.StateMessage): void {
-    this.awaitingStates = Math.max(0, this.awaitingStates - 1);
+    if (STATE_REQUESTS.has(m.request)) this.awaitingStates = Math.max(0, this.awaitingStates - 1);
     if (!this.restoreChecked) {
       this.restoreChecked = true;
       const restarted = m.groups.length === 0 && m.fixed === 0 && !m.undo;
