@@ -102,6 +102,7 @@ void SpectralDeformer::set_selection(const Selection& selection) {
   if (options_.detail == DetailMethod::Transfer) setup_.detail_factorization = clock.lap();
   setup_.selection = total.lap();
   detail_targets_.resize(0, 3);
+  state_ = ArapState{};  // warm starts continue a drag, not across selections
 }
 
 Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms) {
