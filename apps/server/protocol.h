@@ -24,7 +24,7 @@
 //                  u32 ARAP iterations | u32 1 if ARAP converged (or the energy is linear) |
 //                  f32 scale | i16 displacements (3 n, then zeros to a multiple of 4 bytes):
 //                  position = rest position + scale * displacement, of all vertices or of the
-//                  preview's, in its order (a quarter of float32 positions' size; the step is
+//                  preview's, in its order (half the size of float32 positions; the step is
 //                  the largest displacement / 32767)
 //   103 file       the layout of 3: an export for the browser to save
 //   104 selection  the layout of 1 (no fit flags): the server's selection and transforms, for
