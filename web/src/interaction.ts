@@ -69,7 +69,7 @@ export class Interaction {
     e.stopPropagation();
     if (!this.s.editable) {
       this.s.note(this.s.phase.kind === 'disconnected' ? 'not connected: the edit waits for the server'
-        : 'the server is busy: wait for it to finish', 'error');
+        : 'the server is busy: wait for it to finish');
       return;
     }
     const hit = v.pick(e.clientX, e.clientY);
