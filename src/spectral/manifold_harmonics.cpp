@@ -789,9 +789,10 @@ ManifoldHarmonics compute_manifold_harmonics(const Sparse& K, const Sparse& M,
 
 ManifoldHarmonics compute_manifold_harmonics(const TriangleMesh& mesh,
                                              const ManifoldHarmonicsOptions& options) {
-  ManifoldHarmonics h =
-      compute_manifold_harmonics(cotan_stiffness(mesh), mass_matrix(mesh, options.mass), options);
+  const LaplacianOperators L = laplacian_operators(mesh, options.mass, options.laplacian);
+  ManifoldHarmonics h = compute_manifold_harmonics(L.stiffness, L.mass, options);
   h.mass = options.mass;
+  h.laplacian = options.laplacian;
   return h;
 }
 

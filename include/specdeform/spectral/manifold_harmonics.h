@@ -1,9 +1,9 @@
 // Manifold harmonics: the first m eigenpairs of the Laplace-Beltrami operator,
 //     K h = lambda M h,   ascending lambda,   H^T M H = I,
-// with K the cotangent stiffness matrix (operators/cotan_laplacian.h) and M the lumped or
-// consistent mass matrix (operators/mass_matrix.h). Vallet & Levy, "Spectral geometry processing
-// with manifold harmonics" (2008); the basis of Rong, Cao & Guo, "Spectral mesh deformation"
-// (2008).
+// with K the stiffness matrix and M the lumped or consistent mass matrix of the chosen Laplacian
+// (operators/laplacian.h: the cotangent Laplacian, or the intrinsic Delaunay one for bad
+// meshes). Vallet & Levy, "Spectral geometry processing with manifold harmonics" (2008); the
+// basis of Rong, Cao & Guo, "Spectral mesh deformation" (2008).
 //
 // Units: eigenvalues in 1/length^2 of the mesh (the unit sphere gives l(l+1)); the basis is
 // M-orthonormal in the mesh's units (H^T M H = I). Internally the problem is solved on the mesh
@@ -35,6 +35,7 @@
 #include <Eigen/Sparse>
 
 #include "specdeform/mesh/triangle_mesh.h"
+#include "specdeform/operators/laplacian.h"
 #include "specdeform/operators/mass_matrix.h"
 
 namespace specdeform {
@@ -47,6 +48,7 @@ using ProgressCallback = std::function<void(double fraction, std::string_view st
 struct ManifoldHarmonicsOptions {
   int num_modes = 100;  // m, 1 <= m < n
   MassType mass = MassType::Lumped;
+  LaplacianType laplacian = LaplacianType::Cotan;  // the mesh overload's K and M
   EigenSolver solver = EigenSolver::BlockKrylov;
   double tolerance = 1e-10;   // residual each pair must reach, see eigen_residual
   double shift = -0.1;        // first shift sigma on the unit-area scale; must be < 0
@@ -63,6 +65,7 @@ struct ManifoldHarmonics {
   Eigen::VectorXd eigenvalues;  // m, ascending, mesh units
   Eigen::MatrixXd basis;        // n x m, H^T M H = I
   MassType mass = MassType::Lumped;
+  LaplacianType laplacian = LaplacianType::Cotan;  // H is orthonormal in this Laplacian's M
 
   SolveStatus status = SolveStatus::Converged;
   double max_residual = 0.0;             // max over pairs, as `tolerance` defines it
