@@ -40,6 +40,7 @@ void add_basis_command(CLI::App& app) {
       nlohmann::ordered_json j;
       j["vertices"] = loaded.mesh.num_vertices();
       j["modes"] = h.eigenvalues.size();
+      j["laplacian"] = name(h.laplacian);
       j["seconds"] = seconds;
       j["converged"] = converged;
       j["max_residual"] = h.max_residual;

@@ -2,7 +2,7 @@
 #include <memory>
 
 #include "common.h"
-#include "specdeform/operators/mass_matrix.h"
+#include "specdeform/operators/laplacian.h"
 #include "specdeform/spectral/spectral_transform.h"
 
 namespace specdeform::cli {
@@ -25,7 +25,7 @@ void add_smooth_command(CLI::App& app) {
   cmd->callback([args] {
     const LoadedMesh loaded = load_mesh(args->mesh);
     const ManifoldHarmonics h = obtain_basis(loaded.mesh, args->options, args->basis);
-    const auto M = mass_matrix(loaded.mesh, h.mass);
+    const auto M = mass_matrix(loaded.mesh, h.mass, h.laplacian);
     const Eigen::MatrixXd smooth =
         harmonics_inverse(h.basis, harmonics_forward(h.basis, M, loaded.mesh.V));
     write_mesh(args->output, to_file_order(loaded.info, smooth, loaded.mesh.F));

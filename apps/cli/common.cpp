@@ -154,8 +154,13 @@ void add_harmonics_options(CLI::App& cmd, ManifoldHarmonicsOptions& o) {
                                                      {"consistent", MassType::Consistent}};
   static const std::map<std::string, EigenSolver> kSolver{{"krylov", EigenSolver::BlockKrylov},
                                                           {"lanczos", EigenSolver::Lanczos}};
+  static const auto kLaplacian = by_name({LaplacianType::Cotan, LaplacianType::IntrinsicDelaunay});
   cmd.add_option("--mass", o.mass, "mass matrix: lumped (default) or consistent")
       ->transform(CLI::CheckedTransformer(kMass, CLI::ignore_case));
+  cmd.add_option("--laplacian", o.laplacian,
+                 "cotan (the mesh's triangles, default) or intrinsic-delaunay (robust to slivers "
+                 "and non-manifold edges)")
+      ->transform(CLI::CheckedTransformer(kLaplacian, CLI::ignore_case));
   cmd.add_option("--eigensolver", o.solver,
                  "krylov (block Krylov-Schur, default) or lanczos (Spectra, the baseline)")
       ->transform(CLI::CheckedTransformer(kSolver, CLI::ignore_case));
@@ -243,9 +248,7 @@ ManifoldHarmonics obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonics
   if (loaded != nullptr) *loaded = false;
   if (!cache.empty() && std::filesystem::exists(cache)) {
     ManifoldHarmonics h = load_basis(cache, mesh);
-    if (h.mass != options.mass) {
-      throw InputError(cache + ": the basis was computed with the other mass matrix");
-    }
+    require_operators(cache, h, options.mass, options.laplacian);
     if (h.basis.cols() < options.num_modes) {
       throw InputError(cache + ": holds " + std::to_string(h.basis.cols()) + " frequencies, " +
                        std::to_string(options.num_modes) + " are asked for");

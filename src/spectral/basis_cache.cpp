@@ -14,8 +14,8 @@ namespace specdeform {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'D', 'B', 'A', 'S', 'I', 'S', '\0'};
-constexpr uint32_t kVersion = 1;
-constexpr size_t kHeaderSize = 8 + 4 + 4 + 4 + 1 + 1 + 2 + 8;
+constexpr uint32_t kVersion = 2;  // version 1: no Laplacian byte (cotan)
+constexpr size_t kHeaderSize = 8 + 4 + 4 + 4 + 1 + 1 + 1 + 1 + 8;
 
 static_assert(std::endian::native == std::endian::little, "the cache format is little-endian");
 
@@ -64,7 +64,8 @@ void save_basis(const std::filesystem::path& path, const ManifoldHarmonics& basi
   put(out, m);
   put(out, static_cast<uint8_t>(basis.mass == MassType::Lumped ? 0 : 1));
   put(out, static_cast<uint8_t>(single ? 4 : 8));
-  put(out, uint16_t{0});
+  put(out, static_cast<uint8_t>(basis.laplacian == LaplacianType::Cotan ? 0 : 1));
+  put(out, uint8_t{0});
   put(out, mesh_hash(mesh));
   out.append(reinterpret_cast<const char*>(basis.eigenvalues.data()), 8 * size_t(m));
   if (single) {
@@ -85,26 +86,28 @@ ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMe
   if (std::memcmp(header, kMagic, 8) != 0) throw InputError(name + ": not a specdeform basis file");
   const char* p = header + 8;
   const auto version = get<uint32_t>(p);
-  if (version != kVersion) {
+  if (version != 1 && version != kVersion) {
     throw InputError(name + ": basis file version " + std::to_string(version) +
-                     " is not supported (this build reads version " + std::to_string(kVersion) +
-                     ")");
+                     " is not supported (this build reads versions 1 to " +
+                     std::to_string(kVersion) + ")");
   }
   const auto n = get<uint32_t>(p);
   const auto m = get<uint32_t>(p);
   const auto mass = get<uint8_t>(p);
   const auto scalar = get<uint8_t>(p);
-  get<uint16_t>(p);
+  const auto laplacian = get<uint8_t>(p);
+  get<uint8_t>(p);
   const auto hash = get<uint64_t>(p);
   if (n != static_cast<uint32_t>(mesh.num_vertices()) || hash != mesh_hash(mesh)) {
     throw InputError(name + ": the basis belongs to another mesh (" + std::to_string(n) +
                      " vertices, different geometry or faces); recompute it");
   }
-  if (mass > 1 || (scalar != 4 && scalar != 8) || m == 0 || m > n) {
+  if (mass > 1 || (scalar != 4 && scalar != 8) || laplacian > 1 || m == 0 || m > n) {
     throw InputError(name + ": corrupt basis header");
   }
   ManifoldHarmonics out;
   out.mass = mass == 0 ? MassType::Lumped : MassType::Consistent;
+  out.laplacian = laplacian == 0 ? LaplacianType::Cotan : LaplacianType::IntrinsicDelaunay;
   out.eigenvalues.resize(m);
   out.basis.resize(n, m);
   bool ok =
@@ -118,6 +121,26 @@ ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMe
   }
   if (!ok) throw InputError(name + ": truncated basis file");
   return out;
+}
+
+void require_operators(const std::filesystem::path& path, const ManifoldHarmonics& basis,
+                       MassType mass, LaplacianType laplacian) {
+  const auto mass_name = [](MassType type) {
+    return std::string(type == MassType::Lumped ? "the lumped" : "the consistent") + " mass matrix";
+  };
+  const auto laplacian_name = [](LaplacianType type) {
+    return "the " + std::string(name(type)) + " Laplacian";
+  };
+  std::string found, wanted;
+  if (basis.mass != mass) found = mass_name(basis.mass), wanted = mass_name(mass);
+  if (basis.laplacian != laplacian) {
+    const std::string both = found.empty() ? "" : " and ";
+    found += both + laplacian_name(basis.laplacian);
+    wanted += both + laplacian_name(laplacian);
+  }
+  if (found.empty()) return;
+  throw InputError(path.string() + ": the basis was computed with " + found + ", not " + wanted +
+                   "; recompute it or ask for the same operators");
 }
 
 }  // namespace specdeform

@@ -32,6 +32,11 @@ expect 1 "$bin" info "$tmp/trunc.off"
 expect 1 "$bin" basis "$tmp/s.off" -m 100000
 expect 1 "$bin" smooth "$tmp/fine.obj" -m 9 --basis "$tmp/s.sdbasis" -o "$tmp/x.obj"
 [ -e "$tmp/x.obj" ] && { echo "FAIL: output written despite an error"; fails=$((fails + 1)); }
+# --laplacian: the cache records it, and a cache of the other Laplacian is refused.
+expect 0 "$bin" smooth "$tmp/s.off" -m 9 --laplacian intrinsic-delaunay --basis "$tmp/id.sdbasis" -o "$tmp/smooth-id.ply"
+expect 1 "$bin" smooth "$tmp/s.off" -m 9 --basis "$tmp/id.sdbasis" -o "$tmp/x.ply"
+grep -qF 'computed with the intrinsic-delaunay Laplacian' "$tmp/err" || { echo "FAIL: cache of the other Laplacian: $(cat "$tmp/err")"; fails=$((fails + 1)); }
+expect 2 "$bin" basis "$tmp/s.off" -m 9 --laplacian delaunay
 # deform: a JSON scene, the Botsch-Sorkine files, errors
 "$bin" generate bumpy-plane --resolution 16 -o "$tmp/p.off" >/dev/null
 printf '{"handles": [{"vertices": [288], "transform": {"translate": [0, 0, 0.2]}}], "fixed": [0, 1, 2, 16]}' >"$tmp/scene.json"

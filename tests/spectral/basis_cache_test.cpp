@@ -44,6 +44,51 @@ TEST_F(BasisCache, RoundTrip) {
             0.6 * std::filesystem::file_size(dir_ / "b.sdbasis"));
 }
 
+TEST_F(BasisCache, RecordsTheLaplacian) {
+  ManifoldHarmonicsOptions o;
+  o.num_modes = 10;
+  o.laplacian = LaplacianType::IntrinsicDelaunay;
+  const ManifoldHarmonics intrinsic = compute_manifold_harmonics(mesh_, o);
+  save_basis(dir_ / "i.sdbasis", intrinsic, mesh_);
+  const ManifoldHarmonics back = load_basis(dir_ / "i.sdbasis", mesh_);
+  EXPECT_EQ(back.laplacian, LaplacianType::IntrinsicDelaunay);
+  EXPECT_EQ(back.basis, intrinsic.basis);
+  EXPECT_NO_THROW(
+      require_operators("i.sdbasis", back, MassType::Lumped, LaplacianType::IntrinsicDelaunay));
+  try {
+    require_operators("i.sdbasis", back, MassType::Lumped, LaplacianType::Cotan);
+    FAIL() << "a basis of the other Laplacian was accepted";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "i.sdbasis: the basis was computed with the intrinsic-delaunay Laplacian, not the "
+                 "cotan Laplacian; recompute it or ask for the same operators");
+  }
+  EXPECT_THROW(
+      require_operators("i.sdbasis", back, MassType::Consistent, LaplacianType::IntrinsicDelaunay),
+      InputError);
+}
+
+TEST_F(BasisCache, ReadsVersionOneAsCotan) {
+  // Version 1 had a reserved zero where version 2 keeps the Laplacian.
+  save_basis(dir_ / "b.sdbasis", h_, mesh_);
+  {
+    std::fstream file(dir_ / "b.sdbasis", std::ios::in | std::ios::out | std::ios::binary);
+    const uint32_t version = 1;
+    file.seekp(8);
+    file.write(reinterpret_cast<const char*>(&version), sizeof version);
+  }
+  const ManifoldHarmonics back = load_basis(dir_ / "b.sdbasis", mesh_);
+  EXPECT_EQ(back.laplacian, LaplacianType::Cotan);
+  EXPECT_EQ(back.basis, h_.basis);
+  {
+    std::fstream file(dir_ / "b.sdbasis", std::ios::in | std::ios::out | std::ios::binary);
+    const uint32_t version = 3;
+    file.seekp(8);
+    file.write(reinterpret_cast<const char*>(&version), sizeof version);
+  }
+  EXPECT_THROW(load_basis(dir_ / "b.sdbasis", mesh_), InputError);
+}
+
 TEST_F(BasisCache, RefusesAnotherMeshOrABrokenFile) {
   save_basis(dir_ / "b.sdbasis", h_, mesh_);
   TriangleMesh moved = mesh_;

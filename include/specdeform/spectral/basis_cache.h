@@ -2,11 +2,14 @@
 //
 // Binary, little-endian, versioned:
 //   "SDBASIS\0" (8 bytes) | version u32 | n u32 | m u32 | mass u8 (0 lumped, 1 consistent) |
-//   scalar u8 (8 = float64, 4 = float32) | reserved u16 | mesh hash u64 |
-//   eigenvalues (m x f64) | basis (n x m, column-major, float64 or float32)
-// The mesh hash covers the vertex positions and the faces, so loading refuses, with a clear
-// message, a basis that was computed for another mesh (or another version of it). float32
-// storage halves the file; loading converts back to double. Files are written atomically.
+//   scalar u8 (8 = float64, 4 = float32) | laplacian u8 (0 cotan, 1 intrinsic-delaunay) |
+//   reserved u8 | mesh hash u64 | eigenvalues (m x f64) | basis (n x m, column-major, float64 or
+//   float32)
+// Version 2 added the Laplacian in a byte that version 1 reserved (always 0): version 1 files
+// are read as cotan bases. The mesh hash covers the vertex positions and the faces, so loading
+// refuses, with a clear message, a basis that was computed for another mesh (or another version
+// of it). float32 storage halves the file; loading converts back to double. Files are written
+// atomically.
 #pragma once
 
 #include <cstdint>
@@ -26,7 +29,12 @@ void save_basis(const std::filesystem::path& path, const ManifoldHarmonics& basi
                 const TriangleMesh& mesh, BasisPrecision precision = BasisPrecision::Float64);
 
 // Throws InputError if the file is unreadable, not a basis file, of another version, truncated,
-// or computed for another mesh.
+// or computed for another mesh. The result's `mass` and `laplacian` are the file's.
 ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMesh& mesh);
+
+// Throws InputError, naming the file and both choices, unless the basis was computed with this
+// mass matrix and Laplacian: a basis is orthonormal only in its own operators.
+void require_operators(const std::filesystem::path& path, const ManifoldHarmonics& basis,
+                       MassType mass, LaplacianType laplacian);
 
 }  // namespace specdeform
