@@ -9,7 +9,7 @@
 namespace specdeform::cli {
 
 void add_info_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("info", "print a mesh's topology and geometry");
+  auto* cmd = app.add_subcommand("info", "print a mesh's topology, geometry and defects");
   struct Args {
     std::string path;
     bool json = false;
@@ -36,18 +36,43 @@ void add_info_command(CLI::App& app) {
     j["bbox_diagonal"] = i.bbox_diagonal;
     j["non_manifold_edges"] = i.non_manifold_edges;
     j["degenerate_faces"] = i.degenerate_faces;
+    // Defects, their first vertex in the file's numbering (null: none).
+    const auto file_vertex = [&](int v) {
+      return v < 0 ? nlohmann::ordered_json()
+                   : nlohmann::ordered_json(loaded.info.vertex_to_file[v]);
+    };
+    j["zero_area_vertices"] = i.zero_area_vertices;
+    j["first_zero_area_vertex"] = file_vertex(i.first_zero_area_vertex);
+    j["pinch_vertices"] = i.pinch_vertices;
+    j["first_pinch_vertex"] = file_vertex(i.first_pinch_vertex);
+    j["inconsistent_edges"] = i.inconsistent_edges;
+    j["misoriented_components"] = i.misoriented_components;
+    j["first_inconsistent_edge"] =
+        i.inconsistent_edges == 0
+            ? nlohmann::ordered_json()
+            : nlohmann::ordered_json({file_vertex(i.first_inconsistent_edge[0]),
+                                      file_vertex(i.first_inconsistent_edge[1])});
+    j["coincident_vertices"] = i.coincident_vertices;
+    j["first_coincident_vertices"] =
+        i.coincident_vertices == 0
+            ? nlohmann::ordered_json()
+            : nlohmann::ordered_json({file_vertex(i.first_coincident_vertices[0]),
+                                      file_vertex(i.first_coincident_vertices[1])});
     j["unused_vertices"] = loaded.info.unused_vertices;
     j["collapsed_faces"] = loaded.info.collapsed_faces;
     j["file_vertices"] = loaded.info.file_vertices.rows();
     j["file_faces"] = loaded.info.file_faces;
     j["welded_corners"] = loaded.info.welded_corners;
+    const auto text = [](const nlohmann::ordered_json& v) {
+      return v.is_string() ? v.get<std::string>()
+                           : v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    };
     if (json) {
-      std::cout << j.dump() << "\n";
+      std::cout << text(j) << "\n";
       return;
     }
     for (const auto& [key, value] : j.items()) {
-      std::cout << key << ": " << (value.is_string() ? value.get<std::string>() : value.dump())
-                << "\n";
+      if (!value.is_null()) std::cout << key << ": " << text(value) << "\n";
     }
   });
 }
