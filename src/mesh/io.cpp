@@ -9,10 +9,12 @@
 #include <fstream>
 #include <numeric>
 #include <sstream>
+#include <unordered_set>
 
 #include "polygon_soup.h"
 #include "specdeform/atomic_file.h"
 #include "specdeform/exceptions.h"
+#include "text_scanner.h"
 
 namespace specdeform {
 
@@ -27,6 +29,49 @@ MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
   throw InputError(path.string() + ": unknown mesh format '" + ext +
                    "' (expected .obj, .off, .ply or .stl)");
 }
+
+namespace {
+
+// The corner from which to fan-triangulate each polygon: the first whose diagonals are not edges
+// of the mesh already (sides of polygons, or diagonals chosen before). Two polygons that share two
+// consecutive sides would otherwise both take the diagonal between the far ends of those sides:
+// one triangle twice, back to back, and two non-manifold edges.
+std::vector<int> fan_apexes(const detail::PolygonSoup& soup) {
+  const int np = soup.num_polygons();
+  std::vector<int> apex(np, 0);
+  const auto corners = [&](int p) { return soup.offsets[p + 1] - soup.offsets[p]; };
+  bool polygons = false;
+  for (int p = 0; p < np && !polygons; ++p) polygons = corners(p) > 3;
+  if (!polygons) return apex;
+  const auto key = [](int a, int b) {
+    return uint64_t(uint32_t(std::min(a, b))) << 32 | uint32_t(std::max(a, b));
+  };
+  std::unordered_set<uint64_t> edges;
+  for (int p = 0; p < np; ++p) {
+    const int* v = soup.indices.data() + soup.offsets[p];
+    for (int c = 0, k = corners(p); c < k; ++c) edges.insert(key(v[c], v[(c + 1) % k]));
+  }
+  for (int p = 0; p < np; ++p) {
+    const int* v = soup.indices.data() + soup.offsets[p];
+    const int k = corners(p);
+    if (k < 4) continue;
+    const auto free = [&](int s) {
+      for (int j = 2; j <= k - 2; ++j)
+        if (edges.count(key(v[s], v[(s + j) % k]))) return false;
+      return true;
+    };
+    for (int s = 0; s < k; ++s) {
+      if (free(s)) {
+        apex[p] = s;
+        break;
+      }
+    }
+    for (int j = 2; j <= k - 2; ++j) edges.insert(key(v[apex[p]], v[(apex[p] + j) % k]));
+  }
+  return apex;
+}
+
+}  // namespace
 
 namespace detail {
 
@@ -49,12 +94,12 @@ LoadedMesh build_mesh(PolygonSoup soup, const std::string& name) {
       soup.xyz.data(), nv, 3);
 
   std::vector<int> tris;
+  const std::vector<int> apex = fan_apexes(soup);
   for (int p = 0; p < soup.num_polygons(); ++p) {
-    const int begin = soup.offsets[p];
-    const int k = soup.offsets[p + 1] - begin;
+    const int* v = soup.indices.data() + soup.offsets[p];
+    const int k = soup.offsets[p + 1] - soup.offsets[p];
     for (int c = 1; c + 1 < k; ++c) {  // fan triangulation
-      const int a = soup.indices[begin], b = soup.indices[begin + c],
-                d = soup.indices[begin + c + 1];
+      const int a = v[apex[p]], b = v[(apex[p] + c) % k], d = v[(apex[p] + c + 1) % k];
       if (a == b || b == d || a == d) {
         ++info.collapsed_faces;
         continue;
@@ -91,6 +136,7 @@ LoadedMesh build_mesh(PolygonSoup soup, const std::string& name) {
 
 LoadedMesh read_mesh_from_memory(std::string_view data, MeshFormat format, std::string_view name) {
   const std::string n(name);
+  detail::reject_git_lfs_pointer(data, n, "mesh");
   switch (format) {
     case MeshFormat::Obj:
       return detail::build_mesh(detail::parse_obj(data, n), n);

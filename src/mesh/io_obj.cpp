@@ -59,6 +59,13 @@ PolygonSoup parse_obj(std::string_view raw, const std::string& name) {
         }
         corners.push_back(static_cast<int>(zero_based));
       }
+      if (corners.size() < 3) {
+        if (in.position() == data.size() && !data.ends_with('\n')) {
+          in.fail("truncated: the file ends inside face " + std::to_string(line_faces));
+        }
+        in.fail("face " + std::to_string(line_faces) + " has " + std::to_string(corners.size()) +
+                " corners (a face needs 3 or more)");
+      }
       for (const int c : corners) soup.add_polygon_corner(c);
       soup.end_polygon();
       ++line_faces;

@@ -128,6 +128,40 @@ class BodyReader {
   size_t pos_ = 0;
 };
 
+// Triangle strips s0 s1 s2 s3 ...: (s0 s1 s2), (s2 s1 s3), (s2 s3 s4), ..., every second one
+// reversed so that all face the same way. -1 starts a new strip; triangles that repeat a vertex
+// (a strip's turns) are left out.
+class StripReader {
+ public:
+  explicit StripReader(PolygonSoup& soup) : soup_(soup) {}
+  void restart() { count_ = 0; }
+  void add(int v) {
+    if (v < 0) return restart();
+    if (count_ >= 2 && v != a_ && v != b_ && a_ != b_) {
+      const bool odd = count_ % 2 == 1;
+      for (const int c : {odd ? b_ : a_, odd ? a_ : b_, v}) soup_.add_polygon_corner(c);
+      soup_.end_polygon();
+    }
+    a_ = b_;
+    b_ = v;
+    ++count_;
+  }
+
+ private:
+  PolygonSoup& soup_;
+  long long count_ = 0;
+  int a_ = -1, b_ = -1;  // the strip's last two vertices
+};
+
+// The position of the element's list of vertex indices; InputError if it has none.
+int index_list(const Element& e, const std::string& name) {
+  for (size_t i = 0; i < e.properties.size(); ++i) {
+    const Property& p = e.properties[i];
+    if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) return int(i);
+  }
+  throw InputError(name + ": PLY element '" + e.name + "' has no vertex_indices list");
+}
+
 }  // namespace
 
 PolygonSoup parse_ply(std::string_view data, const std::string& name) {
@@ -184,12 +218,16 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name) {
 
   const Element* vertex = nullptr;
   const Element* face = nullptr;
+  const Element* strips = nullptr;
   for (const Element& e : elements) {
     if (e.name == "vertex") vertex = &e;
     if (e.name == "face") face = &e;
+    if (e.name == "tristrips") strips = &e;
   }
   if (vertex == nullptr || vertex->count == 0) throw InputError(name + ": no vertices");
-  if (face == nullptr || face->count == 0) {
+  if (face != nullptr && face->count == 0) face = nullptr;
+  if (strips != nullptr && strips->count == 0) strips = nullptr;
+  if (face == nullptr && strips == nullptr) {
     throw InputError(name + ": no faces (a point cloud is not a surface)");
   }
   int xyz_index[3] = {-1, -1, -1};
@@ -202,15 +240,12 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name) {
   if (xyz_index[0] < 0 || xyz_index[1] < 0 || xyz_index[2] < 0) {
     throw InputError(name + ": PLY vertices lack an x, y or z property");
   }
-  int index_list = -1;
-  for (size_t i = 0; i < face->properties.size(); ++i) {
-    const Property& p = face->properties[i];
-    if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) index_list = int(i);
-  }
-  if (index_list < 0) throw InputError(name + ": PLY faces lack a vertex_indices list");
+  const int face_list = face != nullptr ? index_list(*face, name) : -1;
+  const int strip_list = strips != nullptr ? index_list(*strips, name) : -1;
 
   BodyReader in(data.substr(body_start), enc, name);
   PolygonSoup soup;
+  StripReader strip(soup);
   // Each value takes at least one byte (binary) or two characters (ascii).
   for (const Element& e : elements) {
     if (e.count > static_cast<long long>(in.remaining())) {
@@ -233,18 +268,26 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name) {
         if (!(count >= 0) || count > static_cast<double>(in.remaining())) {
           throw InputError(name + ": bad list length in element '" + e.name + "'");
         }
+        const bool is_face = &e == face && int(i) == face_list;
+        const bool is_strip = &e == strips && int(i) == strip_list;
         for (long long c = 0; c < static_cast<long long>(count); ++c) {
           const double v = in.read(p.type, "a list");
-          if (&e == face && int(i) == index_list) {
-            if (!(v >= 0 && v < static_cast<double>(vertex->count)) || v != std::floor(v)) {
-              throw InputError(name + ": face " + std::to_string(r) + " references vertex " +
-                               std::to_string(static_cast<long long>(v)) + " but there are " +
-                               std::to_string(vertex->count) + " vertices");
-            }
+          if (!is_face && !is_strip) continue;
+          if (!(v >= (is_strip ? -1 : 0) && v < static_cast<double>(vertex->count)) ||
+              v != std::floor(v)) {
+            throw InputError(name + ": " + (is_face ? "face " : "triangle strip ") +
+                             std::to_string(r) + " references vertex " +
+                             std::to_string(static_cast<long long>(v)) + " but there are " +
+                             std::to_string(vertex->count) + " vertices");
+          }
+          if (is_face) {
             soup.add_polygon_corner(static_cast<int>(v));
+          } else {
+            strip.add(static_cast<int>(v));
           }
         }
-        if (&e == face && int(i) == index_list) soup.end_polygon();
+        if (is_face) soup.end_polygon();
+        if (is_strip) strip.restart();
       }
       if (&e == vertex) soup.xyz.insert(soup.xyz.end(), xyz, xyz + 3);
       in.end_entry();

@@ -1,8 +1,8 @@
-// Internal: a small line-aware tokenizer for the ASCII mesh formats (OFF, ASCII PLY/STL).
+// Internal: a small line-aware tokenizer for the text formats (OBJ, OFF, ASCII PLY/STL, and the
+// scenes' .sel, .dmat and .def files).
 #pragma once
 
 #include <charconv>
-#include <optional>
 #include <string>
 #include <string_view>
 
@@ -48,30 +48,16 @@ class TextScanner {
     return p >= data_.size() || data_[p] == '\n' || data_[p] == '#';
   }
 
-  double next_double(const char* what) {
-    const std::string_view t = next();
-    double v = 0.0;
-    if (t.empty()) fail(std::string("unexpected end of file while reading ") + what);
-    const char* begin = t.data();
-    if (*begin == '+') ++begin;
-    const auto [end, ec] = std::from_chars(begin, t.data() + t.size(), v);
-    if (ec != std::errc() || end != t.data() + t.size()) {
-      fail(std::string("bad number '") + std::string(t.substr(0, 32)) + "' in " + what);
-    }
-    return v;
-  }
+  double next_double(const char* what) { return to_double(next(), what); }
+  long long next_integer(const char* what) { return to_integer(next(), what); }
 
-  long long next_integer(const char* what) {
-    const std::string_view t = next();
-    long long v = 0;
-    if (t.empty()) fail(std::string("unexpected end of file while reading ") + what);
-    const char* begin = t.data();
-    if (*begin == '+') ++begin;
-    const auto [end, ec] = std::from_chars(begin, t.data() + t.size(), v);
-    if (ec != std::errc() || end != t.data() + t.size()) {
-      fail(std::string("bad integer '") + std::string(t.substr(0, 32)) + "' in " + what);
-    }
-    return v;
+  // A token from next() as a number or an integer; fail()s naming `what` for anything else (an
+  // empty token means the data ended).
+  double to_double(std::string_view t, const char* what) const {
+    return parse<double>(t, what, "number");
+  }
+  long long to_integer(std::string_view t, const char* what) const {
+    return parse<long long>(t, what, "integer");
   }
 
   size_t position() const { return pos_; }
@@ -79,6 +65,18 @@ class TextScanner {
   [[noreturn]] void fail(const std::string& what) const { throw InputError(name_ + ": " + what); }
 
  private:
+  template <typename T>
+  T parse(std::string_view t, const char* what, const char* kind) const {
+    if (t.empty()) fail(std::string("unexpected end of file while reading ") + what);
+    const char* begin = t.data();
+    if (*begin == '+') ++begin;
+    T v{};
+    const auto [end, ec] = std::from_chars(begin, t.data() + t.size(), v);
+    if (ec != std::errc() || end != t.data() + t.size()) {
+      fail("bad " + std::string(kind) + " '" + std::string(t.substr(0, 32)) + "' in " + what);
+    }
+    return v;
+  }
   static bool is_space(char c) {
     return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
   }
@@ -86,5 +84,14 @@ class TextScanner {
   std::string name_;
   size_t pos_ = 0;
 };
+
+// The small text file Git LFS leaves in place of a file it has not fetched: InputError
+// "<name>: is a Git LFS pointer, not the <what>: run git lfs pull".
+inline void reject_git_lfs_pointer(std::string_view data, const std::string& name,
+                                   const char* what) {
+  if (data.starts_with("version https://git-lfs.github.com/spec/")) {
+    throw InputError(name + ": is a Git LFS pointer, not the " + what + ": run git lfs pull");
+  }
+}
 
 }  // namespace specdeform::detail

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -11,6 +12,7 @@
 
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/generate.h"
+#include "specdeform/mesh/mesh_info.h"
 #include "support/corpus.h"
 
 namespace specdeform {
@@ -94,6 +96,20 @@ TEST(MeshIo, ObjForms) {
   EXPECT_EQ(m.info.file_faces, 3);
   EXPECT_EQ(m.mesh.F.row(2), Eigen::RowVector3i(4, 0, 1));
   EXPECT_EQ(m.info.face_to_file, (std::vector<int>{0, 0, 1, 2}));
+}
+
+// Two quads that share two sides (a b c d and c b a e, as the beast has them): fanned from their
+// first corners both would take the diagonal a c, one triangle twice back to back; the second is
+// fanned from b instead, and the mesh stays manifold and consistently oriented.
+TEST(MeshIo, PolygonsSharingTwoSidesAreNotFolded) {
+  const LoadedMesh m = parse(
+      "v 0 0 0\nv 1 0.2 0\nv 2 0 0\nv 1 -1 0\nv 1 1 0\nf 1 2 3 4\nf 3 2 1 5\n", MeshFormat::Obj);
+  Faces expected(4, 3);
+  expected << 0, 1, 2, 0, 2, 3, 1, 0, 4, 1, 4, 2;
+  EXPECT_EQ(m.mesh.F, expected);
+  const MeshInfo info = compute_mesh_info(m.mesh);
+  EXPECT_EQ(info.non_manifold_edges, 0);
+  EXPECT_EQ(info.inconsistent_edges, 0);
 }
 
 TEST(MeshIo, OffVariants) {
@@ -182,6 +198,60 @@ TEST(MeshIo, PlyEncodingsAndTypes) {
             4);
 }
 
+// Three rows of two vertices (b0 b1, t0 t1, u0 u1 at y = 0, 1, 2) and their four triangles as
+// triangle strips in a list of `indices`, in the given PLY encoding (list int int).
+std::string strip_ply(const std::string& format, const std::vector<int>& indices) {
+  std::string s = "ply\nformat " + format + " 1.0\nelement vertex 6\nproperty float x\n";
+  s += "property float y\nproperty float z\nelement tristrips 1\n";
+  s += "property list int int vertex_indices\nend_header\n";
+  const float pts[6][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 2, 0}, {1, 2, 0}};
+  if (format == "ascii") {
+    for (const auto& p : pts) s += std::to_string(p[0]) + " " + std::to_string(p[1]) + " 0\n";
+    s += std::to_string(indices.size());
+    for (const int i : indices) s += " " + std::to_string(i);
+    return s + "\n";
+  }
+  const bool big = format == "binary_big_endian";
+  const auto put = [&](auto x) {
+    char b[sizeof(x)];
+    std::memcpy(b, &x, sizeof(x));
+    if (big) std::reverse(b, b + sizeof(x));
+    s.append(b, sizeof(x));
+  };
+  for (const auto& p : pts)
+    for (const float c : p) put(c);
+  put(static_cast<int32_t>(indices.size()));
+  for (const int i : indices) put(static_cast<int32_t>(i));
+  return s;
+}
+
+TEST(MeshIo, PlyTriangleStrips) {
+  // b0 t0 b1 t1 | t0 u0 t1 u1: once joined by the repeated vertices of a turn (t1 t1 t0 t0, four
+  // triangles dropped, the parity kept), once restarted by -1.
+  const std::vector<int> joined = {0, 2, 1, 3, 3, 2, 2, 4, 3, 5};
+  const std::vector<int> restarted = {0, 2, 1, 3, -1, 2, 4, 3, 5};
+  Faces expected(4, 3);
+  expected << 0, 2, 1, 1, 2, 3, 2, 4, 3, 3, 4, 5;  // (a b c), (c b d): all facing -z
+  for (const char* format : {"ascii", "binary_little_endian", "binary_big_endian"}) {
+    for (const auto& strip : {joined, restarted}) {
+      const LoadedMesh m = parse(strip_ply(format, strip), MeshFormat::Ply);
+      EXPECT_EQ(m.mesh.F, expected) << format;
+      EXPECT_EQ(m.info.collapsed_faces, 0) << format;
+      EXPECT_EQ(m.info.file_faces, 4) << format;
+      const Eigen::MatrixX3d N = face_normals(m.mesh);
+      for (int f = 0; f < 4; ++f) EXPECT_EQ(N.row(f), Eigen::RowVector3d(0, 0, -1)) << format;
+    }
+  }
+  // Faces and strips in one file; a strip's index out of range.
+  std::string both = strip_ply("ascii", restarted);
+  both.replace(both.find("end_header"), 10,
+               "element face 1\nproperty list uchar int vertex_indices\nend_header");
+  both += "3 0 1 4\n";
+  EXPECT_EQ(parse(both, MeshFormat::Ply).mesh.num_faces(), 5);
+  expect_error(strip_ply("ascii", {0, 2, 9}), MeshFormat::Ply,
+               "triangle strip 0 references vertex 9");
+}
+
 TEST(MeshIo, StlAsciiAndBinary) {
   const char* ascii =
       "solid thing\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
@@ -234,6 +304,20 @@ TEST(MeshIo, ClearErrors) {
   expect_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", MeshFormat::Obj, "references vertex 4");
   expect_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", MeshFormat::Obj, "bad face corner");
   expect_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -4 1 2\n", MeshFormat::Obj, "references vertex -4");
+  // Cut inside the last face line; a face of two corners elsewhere.
+  expect_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4", MeshFormat::Obj,
+               "truncated: the file ends inside face 1");
+  expect_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2/1", MeshFormat::Obj, "truncated");
+  expect_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\nf 1 2 3\n", MeshFormat::Obj,
+               "face 0 has 2 corners");
+  EXPECT_EQ(parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3", MeshFormat::Obj).mesh.num_faces(), 1);
+  // A Git LFS pointer in place of the mesh, whatever the format.
+  for (const MeshFormat f : {MeshFormat::Obj, MeshFormat::Off, MeshFormat::Ply, MeshFormat::Stl}) {
+    expect_error(
+        "version https://git-lfs.github.com/spec/v1\noid sha256:4d7a214614ab2935c943f9e0ff69d22ea"
+        "dbb8f32b1258daaa5e2ca24d17e2393\nsize 12345\n",
+        f, "is a Git LFS pointer, not the mesh: run git lfs pull");
+  }
   expect_error("ply\nformat ascii 1.0\nend_header\n", MeshFormat::Ply, "no vertices");
   expect_error(
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"

@@ -1,20 +1,27 @@
 // Reading and writing triangle meshes: OBJ, OFF, PLY and STL.
 //
 // Readers:
-//  - OBJ: polygons are fan-triangulated; negative (relative) indices, the v, v/vt, v//vn and
-//    v/vt/vn corner forms and backslash line continuations are accepted; groups, materials,
-//    texture coordinates and normals are ignored.
+//  - OBJ: negative (relative) indices, the v, v/vt, v//vn and v/vt/vn corner forms and
+//    backslash line continuations are accepted; groups, materials, texture coordinates and
+//    normals are ignored. A face of fewer than 3 corners is an error (a file cut inside a face
+//    line is reported as truncated).
 //  - OFF: OFF, COFF, NOFF, CNOFF and STOFF headers, '#' comments, extra per-vertex or per-face
-//    values (colours, normals) ignored. Polygons are fan-triangulated.
+//    values (colours, normals) ignored.
 //  - PLY: ascii, binary_little_endian and binary_big_endian; x/y/z of any scalar type; faces from
-//    a list property named vertex_indices or vertex_index of any integer types; every other
-//    element and property is skipped (in ASCII files, so is anything after an entry's values
-//    on its line).
+//    a list property named vertex_indices or vertex_index of any integer types, in element
+//    "face" (polygons) or "tristrips" (triangle strips as the Stanford and VCG files have them:
+//    -1 starts a new strip, every second triangle is turned to face the same way as the first,
+//    and the triangles of a strip's turns, which repeat a vertex, are left out; each other
+//    triangle counts as one file polygon); every other element and property is skipped (in
+//    ASCII files, so is anything after an entry's values on its line).
 //  - STL: ascii and binary; exactly coincident corners are welded into shared vertices, so file
 //    triangle t has the corners F(t, 0..2) (no triangle is reordered).
 // Every reader validates what it reads and throws InputError with a one-line message naming the
 // file: empty file, header only, no faces, index out of range, NaN/Inf coordinates, truncated
-// data. Faces that repeat a vertex are dropped; vertices that no face uses are dropped. The maps
+// data, a Git LFS pointer left in place of the mesh ("run git lfs pull"). Polygons are
+// fan-triangulated from their first corner whose diagonals are not edges of the mesh already (two
+// polygons that share two sides would otherwise both take one diagonal: a triangle twice, back to
+// back). Faces that repeat a vertex are dropped; vertices that no face uses are dropped. The maps
 // in MeshReadInfo lead back to the file, so results can be written in the file's order.
 //
 // Writers choose the format from the extension (.obj .off .ply .stl). OBJ and OFF print the
