@@ -202,16 +202,14 @@ LoadedScene load_scene(const std::string& mesh_path, const SceneArgs& args,
   std::string path = mesh_path;
   if (path.empty()) {
     if (args.scene.empty()) throw CLI::ValidationError("MESH", "MESH is required");
-    // The mesh is named by the scene: read it once for the name, then again with the mesh's
-    // positions (for centroid centres).
-    const Scene named = read_scene(args.scene, Vertices(0, 3));
-    if (named.mesh.empty()) throw InputError(args.scene + ": the scene names no mesh; give MESH");
-    path = named.mesh.string();
+    path = scene_mesh(args.scene).string();
+    if (path.empty()) throw InputError(args.scene + ": the scene names no mesh; give MESH");
   }
   LoadedScene out{load_mesh(path), {}, {}};
-  const int file_vertices = static_cast<int>(out.mesh.info.file_vertices.rows());
+  const MeshReadInfo& info = out.mesh.info;
+  const int file_vertices = static_cast<int>(info.file_vertices.rows());
   if (!args.scene.empty()) {
-    out.scene = read_scene(args.scene, out.mesh.info.file_vertices, defaults);
+    out.scene = read_scene(args.scene, info, defaults);
   } else {
     out.scene.options = defaults;
     out.scene.selection =
@@ -219,7 +217,12 @@ LoadedScene load_scene(const std::string& mesh_path, const SceneArgs& args,
     out.scene.transforms = read_def(args.def);
   }
   out.scene.transforms = match_transforms(out.scene.selection, out.scene.transforms);
-  out.selection = to_mesh_numbering(out.scene.selection, out.mesh.info);
+  const std::string& name = !args.scene.empty() ? args.scene
+                            : !args.sel.empty() ? args.sel
+                                                : args.dmat;
+  std::vector<std::string> notes;
+  out.selection = to_mesh_numbering(out.scene.selection, info, &notes, name);
+  for (const std::string& note : notes) std::cerr << name << ": note: " << note << "\n";
   return out;
 }
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -42,12 +43,17 @@ def read_scene(
     """Reads a scene (docs/scene.md): a JSON scene, or a .sel or .dmat selection with the .def
     file of its transforms. `mesh` defaults to the mesh a JSON scene names (relative to it).
 
-    Raises OSError for a file that cannot be opened, InputError for a malformed one.
+    Raises OSError for a file that cannot be opened, InputError for a malformed one or for a
+    handle group whose vertices the mesh reader all dropped (used by no face); warns
+    (UserWarning) when it dropped some of a group's or of the fixed set's.
     """
     path = os.fspath(path)
     if mesh is None:
         mesh = _named_mesh(path)
-    return Scene(**_read_scene(path, mesh, transforms))
+    fields = _read_scene(path, mesh, transforms)
+    for note in fields.pop("notes"):
+        warnings.warn(f"{path}: {note}", stacklevel=2)
+    return Scene(**fields)
 
 
 def _named_mesh(path: str) -> str:

@@ -41,7 +41,8 @@ py::array index_array(const std::vector<int>& v) {
 }
 
 // The scene `path` (JSON, or a .sel or .dmat with the .def `transforms`) of the mesh file `mesh`:
-// the mesh, the selection in its numbering, one transform per handle group, the settings.
+// the mesh, the selection in its numbering, one transform per handle group, the settings, and
+// notes on the vertices the selection lost to the mesh reader (to_mesh_numbering()).
 py::dict read_scene_files(const std::filesystem::path& path, const std::filesystem::path& mesh,
                           const std::optional<std::filesystem::path>& transforms) {
   check_readable(mesh);
@@ -61,14 +62,16 @@ py::dict read_scene_files(const std::filesystem::path& path, const std::filesyst
     loaded = read_mesh(mesh);
     const int file_vertices = static_cast<int>(loaded.info.file_vertices.rows());
     if (kind == ".json") {
-      scene = read_scene(path, loaded.info.file_vertices);
+      scene = read_scene(path, loaded.info);
     } else {
       scene.selection =
           kind == ".sel" ? read_sel(path, file_vertices) : read_dmat(path, file_vertices);
       scene.transforms = read_def(*transforms);
     }
   }
-  const Selection selection = to_mesh_numbering(scene.selection, loaded.info);
+  std::vector<std::string> notes;
+  const Selection selection =
+      to_mesh_numbering(scene.selection, loaded.info, &notes, path.string());
   py::list handles, matrices;
   for (const std::vector<int>& group : selection.handles) handles.append(index_array(group));
   for (const Eigen::Affine3d& t : match_transforms(scene.selection, scene.transforms)) {
@@ -83,6 +86,7 @@ py::dict read_scene_files(const std::filesystem::path& path, const std::filesyst
   d["transforms"] = matrices;
   d["modes"] = scene.modes;
   d["options"] = to_dict(scene.options);
+  d["notes"] = notes;
   return d;
 }
 

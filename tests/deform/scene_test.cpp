@@ -40,15 +40,19 @@ TEST_F(SceneFiles, SelDefDmat) {
   EXPECT_EQ(match_transforms(dmat, def).size(), 2u);
 }
 
+// Expects f() to throw an InputError of one line that contains `fragment`.
+template <typename F>
+void expect(F&& f, const std::string& fragment) {
+  try {
+    f();
+    ADD_FAILURE() << "no error, expected " << fragment;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(SceneFiles, BadScenesGiveOneLine) {
-  const auto expect = [](auto&& f, const std::string& fragment) {
-    try {
-      f();
-      ADD_FAILURE() << "no error, expected " << fragment;
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-    }
-  };
   expect([&] { read_sel(write("b.sel", "0\n1\n"), 5); }, "2 vertex entries, the mesh has 5");
   expect([&] { read_sel(write("c.sel", "0\n7\n"), 2); }, "status 7");
   expect([&] { read_def(write("b.def", "# x\n1 0 0\n")); }, "16 numbers");
@@ -69,6 +73,207 @@ TEST_F(SceneFiles, BadScenesGiveOneLine) {
             V);
       },
       "not invertible");
+}
+
+TEST_F(SceneFiles, DefWithoutCommentLineAndSelComments) {
+  const auto def = read_def(write("n.def", "1 0 0 1\n0 1 0 2\n0 0 1 3\n0 0 0 1\n"));
+  ASSERT_EQ(def.size(), 1u);
+  EXPECT_EQ(def[0].translation(), Eigen::Vector3d(1, 2, 3));
+  const auto text = read_def(write("t.def", "handle transform\n2 0 0 0 0 2 0 0 0 0 2 0 0 0 0 1\n"));
+  EXPECT_EQ(text[0].linear(), 2 * Eigen::Matrix3d::Identity());
+  EXPECT_EQ(read_sel(write("c.sel", "0 # fixed\n2\n# free next\n1\n"), 3).handles[0],
+            std::vector<int>{1});
+  expect([&] { read_sel(write("x.sel", "0\n2\nfree\n"), 3); }, "x.sel: bad integer 'free'");
+  expect([&] { read_dmat(write("x.dmat", "1 3\n0\n-1\n"), 3); }, "2 vertex entries");
+}
+
+// Every field is read through one checked accessor: a value of the wrong type or range, an
+// unknown key or a missing one is an error naming the field, never a crash.
+TEST_F(SceneFiles, FieldsOfTheWrongTypeNameThemselves) {
+  const Vertices V = Eigen::MatrixX3d::Random(4, 3);
+  const std::pair<std::string, std::string> cases[] = {
+      {R"({"handles": [{"vertices": [0], "transform": {"rotate": {"axis": 5, "degrees": 9}}}]})",
+       "handle 0 transform rotate axis: expected an array of 3 numbers, got a number"},
+      {R"({"handles": [{"vertices": [0], "transform": {"rotate": 5}}]})",
+       "handle 0 transform rotate: expected an object, got a number"},
+      {R"({"handles": [{"vertices": [0], "transform": {"rotate": {"axis": [0, 0, 1]}}}]})",
+       "handle 0 transform rotate: 'degrees' is missing"},
+      {R"({"handles": [{"vertices": "all"}]})",
+       "handle 0 vertices: expected an array, got a string"},
+      {R"({"handles": [{"vertices": [0.5]}]})",
+       "handle 0 vertices 0: expected an integer, got 0.5"},
+      {R"({"handles": [{"vertices": [0], "transform": {"translate": [0, "1", 0]}}]})",
+       "transform translate: expected an array of 3 numbers, got an array"},
+      {R"({"handles": [{"vertices": [0], "transform": {"center": "middle"}}]})",
+       R"(transform center: expected an array of 3 numbers or "centroid", got "middle")"},
+      {R"({"handles": [{"vertices": [0], "transform": {"center": null}}]})",
+       R"(transform center: expected an array of 3 numbers or "centroid", got null)"},
+      {R"({"handles": [{"vertices": [0], "transform": {"translte": [0, 0, 1]}}]})",
+       "handle 0 transform: unknown key 'translte' (known: translate, rotate, scale, center)"},
+      {R"({"handles": [{"vertices": [0], "transform": [[1, 0, 0, 0], [0, 1, 0]]}]})",
+       "a matrix has 4 rows of 4 numbers"},
+      {R"({"handles": [{"vertices": [0], "transform": "up"}]})",
+       "handle 0 transform: expected an object, got a string"},
+      {R"({"handles": [{"around": {"vertex": "3", "radius": 0.1}}]})",
+       "handle 0 around vertex: expected an integer, got a string"},
+      {R"({"handles": [{"vertices": [0], "around": {"vertex": 0, "radius": 0.1}}]})",
+       "give one of 'vertices', 'around' or 'selection'"},
+      {R"({"handles": [{"vertices": [0], "group": 1}]})", "'group' goes with a 'selection'"},
+      {R"({"handles": [{"selection": "x.txt"}]})", "a selection is a .sel or a .dmat file"},
+      {R"({"handles": 5})", "handles: expected an array, got a number"},
+      {R"({"handles": [7]})", "handle 0: expected an object, got a number"},
+      {R"({"handles": [{"vertices": [0]}], "fixed": {"lowest": "10%"}})",
+       "fixed lowest: expected a number, got a string"},
+      {R"({"handles": [{"vertices": [0]}], "fixed": {"lowest": 0.2, "axis": 1}})",
+       "fixed axis: expected a string, got a number"},
+      {R"({"handles": [{"vertices": [0]}], "fixed": true})",
+       "fixed: expected an array of vertices or an object, got a boolean"},
+      {R"({"handles": [{"vertices": [0]}], "settings": {"modes": "many"}})",
+       "settings modes: expected an integer, got a string"},
+      {R"({"handles": [{"vertices": [0]}], "settings": {"energy": "elastic"}})",
+       "settings energy: unknown energy 'elastic' (linear or arap)"},
+      {R"({"handles": [{"vertices": [0]}], "settings": {"iterations": 0}})",
+       "settings iterations: 0 is out of range [1, 1000000]"},
+      {R"({"handles": [{"vertices": [0]}], "settings": {"ks": 0, "kb": 0}})",
+       "settings: deformation options: ks and kb"},
+      {R"({"handles": [{"vertices": [0]}], "settings": {"unconstrained": "drop"}})",
+       "settings unconstrained: unknown unconstrained-pieces policy 'drop' (keep or error)"},
+      {R"({"handles": [{"vertices": [0]}], "settings": {"kb": -1}})", "ks and kb"},
+      {R"({"handles": [{"vertices": [0]}], "setings": {}})", "unknown key 'setings'"},
+      {R"({"mesh": 3, "handles": [{"vertices": [0]}]})", "mesh: expected a string, got a number"},
+      {R"([1, 2])", "expected an object, got an array"},
+      {R"({"handles": [{"vertices": [0], "transform": {"scale": 1e400}}]})", "not valid JSON"},
+      {"{\n  \"handles\": [\n    {\"vertices\": [0],}\n  ]\n}", "not valid JSON (line 3, column"},
+  };
+  for (const auto& [text, fragment] : cases) {
+    const auto path = write("f.json", text);
+    expect([&] { read_scene(path, V); }, path.string() + (fragment.starts_with("not") ? ": " : ""));
+    expect([&] { read_scene(path, V); }, fragment);
+  }
+}
+
+TEST_F(SceneFiles, AllSettingsReadAndWritten) {
+  const Vertices V = Eigen::MatrixX3d::Random(4, 3);
+  const Scene s = read_scene(write("s.json", R"({"handles": [{"vertices": [1]}], "settings": {
+      "modes": 30, "energy": "linear", "ks": 0.5, "kb": 2, "constraint_weight": 1e3,
+      "constraints": "hard", "detail": "frames", "solver": "spatial", "unconstrained": "error",
+      "iterations": 7, "clusters": 12, "arap_bending": 0.25, "arap_tolerance": 1e-6,
+      "history": 0}})"),
+                             V);
+  const DeformOptions& o = s.options;
+  EXPECT_EQ(s.modes, 30);
+  EXPECT_EQ(o.energy, DeformEnergy::Linear);
+  EXPECT_EQ(o.ks, 0.5);
+  EXPECT_EQ(o.kb, 2.0);
+  EXPECT_EQ(o.constraint_weight, 1e3);
+  EXPECT_EQ(o.constraints, ConstraintMode::Hard);
+  EXPECT_EQ(o.detail, DetailMethod::Frames);
+  EXPECT_EQ(o.solver, DeformSolver::Spatial);
+  EXPECT_EQ(o.unconstrained, UnconstrainedPieces::Error);
+  EXPECT_EQ(o.arap.max_iterations, 7);
+  EXPECT_EQ(o.arap.clusters, 12);
+  EXPECT_EQ(o.arap.bending, 0.25);
+  EXPECT_EQ(o.arap.tolerance, 1e-6);
+  EXPECT_EQ(o.arap.history, 0);
+  // Written and read back over other defaults: the same settings.
+  DeformOptions other;
+  other.arap.clusters = 999;
+  other.unconstrained = UnconstrainedPieces::Keep;
+  const Scene back = read_scene(write("b.json", encode_scene(s)), V, other);
+  EXPECT_EQ(back.modes, 30);
+  EXPECT_EQ(back.options.energy, DeformEnergy::Linear);
+  EXPECT_EQ(back.options.unconstrained, UnconstrainedPieces::Error);
+  EXPECT_EQ(back.options.arap.max_iterations, 7);
+  EXPECT_EQ(back.options.arap.clusters, 12);
+  EXPECT_EQ(back.options.arap.bending, 0.25);
+  EXPECT_EQ(back.options.arap.tolerance, 1e-6);
+  EXPECT_EQ(back.options.arap.history, 0);
+  EXPECT_EQ(back.options.constraint_weight, 1e3);
+  // Settings the scene leaves out keep the defaults given.
+  EXPECT_EQ(read_scene(write("d.json", R"({"handles": [{"vertices": [1]}]})"), V, other)
+                .options.arap.clusters,
+            999);
+}
+
+// File vertices 0 and 3 are used by no face: the reader dropped them. A handle group or fixed set
+// left without vertices is an error naming it; one that lost some, a note.
+TEST_F(SceneFiles, VerticesTheReaderDropped) {
+  MeshReadInfo info;
+  info.file_vertices.resize(6, 3);
+  info.file_vertices << 100, -10, 0, 0, 0, 0, 1, 1, 0, 50, 2, 0, 0, 3, 0, 1, 4, 0;
+  info.vertex_to_file = {1, 2, 4, 5};
+  std::vector<std::string> notes;
+  expect(
+      [&] {
+        to_mesh_numbering({{{1}, {0, 3}}, {}}, info, &notes, "s.json");
+      },
+      "s.json: handle group 1: all 2 of its vertices (file vertex 0 first) are used by no "
+      "face, so the mesh reader dropped them");
+  expect([&] { to_mesh_numbering({{{1}}, {3}}, info, &notes, "s.json"); }, "the fixed set: all 1");
+  expect(
+      [&] {
+        to_mesh_numbering({{{1, 6}}, {}}, info, &notes, "s.json");
+      },
+      "vertex 6 is out of range (the file has 6 vertices)");
+  const Selection s = to_mesh_numbering({{{0, 1, 2}, {5}}, {3, 4}}, info, &notes, "s.json");
+  EXPECT_EQ(s.handles, (std::vector<std::vector<int>>{{0, 1}, {3}}));
+  EXPECT_EQ(s.fixed, std::vector<int>{2});
+  EXPECT_EQ(notes,
+            (std::vector<std::string>{
+                "handle group 0: 1 of its 3 vertices are used by no face and were left out",
+                "the fixed set: 1 of its 2 vertices are used by no face and were left out"}));
+  // Regions count the mesh's vertices only: the lowest half of the four kept ones, within 0.3 and
+  // 0.4 diagonals of the kept vertices' box (x 0..1, y 0..4) around vertex 5; the centroid of the
+  // kept vertices of a group.
+  const Scene r = read_scene(write("r.json", R"({
+    "handles": [{"around": {"vertex": 5, "radius": 0.3}},
+                {"around": {"vertex": 5, "radius": 0.4}},
+                {"vertices": [0, 4, 5], "transform": {"scale": 2}}],
+    "fixed": {"lowest": 0.5}})"),
+                             info);
+  EXPECT_EQ(r.selection.handles[0], std::vector<int>{5});
+  EXPECT_EQ(r.selection.handles[1], (std::vector<int>{4, 5}));
+  EXPECT_EQ(r.selection.fixed, (std::vector<int>{1, 2}));
+  EXPECT_LT((r.transforms[2] * Eigen::Vector3d(0.5, 3.5, 0) - Eigen::Vector3d(0.5, 3.5, 0)).norm(),
+            1e-12);
+}
+
+TEST_F(SceneFiles, ParsedFromMemoryWithItsFiles) {
+  const Vertices V = Eigen::MatrixX3d::Random(3, 3);
+  MeshReadInfo info;
+  info.file_vertices = V;
+  info.vertex_to_file = {0, 1, 2};
+  std::vector<std::filesystem::path> asked;
+  const SceneFileReader reader = [&](const std::filesystem::path& p) -> std::string {
+    asked.push_back(p);
+    if (p.filename() == "h.dmat") return "1 3\n-1\n0\n1\n";
+    throw InputError(p.string() + ": cannot open file");
+  };
+  const Scene s = parse_scene(R"({"handles": [{"selection": "h.dmat", "group": 1}]})", "dir/s.json",
+                              info, {}, reader);
+  EXPECT_EQ(s.selection.handles[0], std::vector<int>{2});
+  EXPECT_EQ(asked, std::vector<std::filesystem::path>{"dir/h.dmat"});
+  expect(
+      [&] {
+        parse_scene(R"({"handles": [{"selection": "h.dmat", "group": 2}]})", "s.json", info, {},
+                    reader);
+      },
+      "s.json handle 0 group: h.dmat has no group 2");
+  expect(
+      [&] { parse_scene(R"({"handles": [{"selection": "x.sel"}]})", "s.json", info, {}, reader); },
+      "x.sel: cannot open file");
+}
+
+TEST_F(SceneFiles, TheMeshAScenesNames) {
+  // Read without the mesh: the vertex indices are not checked yet.
+  EXPECT_EQ(scene_mesh(write("m.json", R"({"mesh": "m.off", "handles": [{"vertices": [9]}]})")),
+            dir_ / "m.off");
+  EXPECT_EQ(scene_mesh(write("n.json", R"({"handles": [{"vertices": [9]}]})")),
+            std::filesystem::path());
+  expect([&] { scene_mesh(write("o.json", R"({"mesh": ["m.off"]})")); },
+         "mesh: expected a string, got an array");
+  expect([&] { scene_mesh(write("l.json", "version https://git-lfs.github.com/spec/v1\n")); },
+         "is a Git LFS pointer");
 }
 
 TEST_F(SceneFiles, JsonScene) {

@@ -329,3 +329,25 @@ def test_scene_errors(tmp_path, bar_scene):
 def specdeform_file(folder):
     specdeform.write_mesh(folder / "small.off", *specdeform.icosphere(1))
     return folder / "small.off"
+
+
+def test_scene_vertices_the_reader_dropped(tmp_path):
+    """A vertex no face uses is dropped by the reader: a handle group of such vertices only is an
+    error, one with some of them a warning; the scene's settings come with the scene."""
+    V, F = specdeform.icosphere(1)
+    n = len(V)
+    lines = [f"OFF\n{n + 1} {len(F)} 0"] + [" ".join(map(repr, p)) for p in V] + ["5 5 5"]
+    lines += ["3 " + " ".join(map(str, f)) for f in F]
+    (tmp_path / "m.off").write_text("\n".join(lines) + "\n")
+    scene = {"mesh": "m.off", "handles": [{"vertices": [n]}], "fixed": [1]}
+    (tmp_path / "all.json").write_text(json.dumps(scene))
+    with pytest.raises(specdeform.InputError, match="handle group 0: all 1 of its vertices"):
+        specdeform.read_scene(tmp_path / "all.json")
+    scene["handles"] = [{"vertices": [0, n]}]
+    scene["settings"] = {"unconstrained": "error", "iterations": 9, "arap_bending": 0.5}
+    (tmp_path / "some.json").write_text(json.dumps(scene))
+    with pytest.warns(UserWarning, match="handle group 0: 1 of its 2 vertices are used by no face"):
+        s = specdeform.read_scene(tmp_path / "some.json")
+    assert [list(h) for h in s.handles] == [[0]] and list(s.fixed) == [1]
+    assert s.options["unconstrained"] == "error" and s.options["iterations"] == 9
+    assert s.options["arap_bending"] == 0.5

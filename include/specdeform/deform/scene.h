@@ -18,16 +18,25 @@
 //                           "center": [x, y, z] | "centroid" } } ],   (default: centroid)
 //        "fixed": [4, 5] | { "selection": "x.sel" }   (status 0 of a .sel)
 //                 | { "lowest": f, "axis": "y" },     (fraction f lowest, handles excepted)
-//        "settings": { "modes": 100, "ks": 0, "kb": 1, "constraint_weight": 1e5,
-//                      "constraints": "soft", "detail": "transfer", "solver": "spectral" } }
-//    The transform of a handle maps p to center + R (scale (p - center)) + translate.
-// Vertex indices are the file's; to_mesh_numbering() maps them to a loaded mesh (whose reader
-// may have dropped unused vertices). Every reader throws InputError with a one-line message.
+//        "settings": { "modes": 100, "energy": "arap", "ks": 0, "kb": 1,
+//                      "constraint_weight": 1e5, "constraints": "soft", "detail": "transfer",
+//                      "solver": "spectral", "unconstrained": "keep", "iterations": 100,
+//                      "clusters": 200, "arap_bending": 1e-3, "arap_tolerance": 1e-4,
+//                      "history": 5 } }
+//    The transform of a handle maps p to center + R (scale (p - center)) + translate. Every
+//    field is checked: an unknown key, a value of the wrong type or out of range is an InputError
+//    naming the field ("s.json handle 0 transform rotate axis: expected an array of 3 numbers,
+//    got a number").
+// Vertex indices are the file's. The regions ("around", "lowest") and centroids take only the
+// vertices of the loaded mesh (its reader drops vertices no face uses); to_mesh_numbering() maps
+// a selection to the loaded mesh. Every reader throws InputError with a one-line message.
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -50,18 +59,32 @@ struct Scene {
 Selection read_sel(const std::filesystem::path& path, int file_vertices);
 // .dmat: handle group k = the vertices with value k.
 Selection read_dmat(const std::filesystem::path& path, int file_vertices);
+// .def: the transforms, in order.
+std::vector<Eigen::Affine3d> read_def(const std::filesystem::path& path);
 // The same from a file's contents; `name` prefixes error messages.
 Selection parse_sel(std::string_view text, int file_vertices, std::string_view name);
 Selection parse_dmat(std::string_view text, int file_vertices, std::string_view name);
-// .def: the transforms, in order.
-std::vector<Eigen::Affine3d> read_def(const std::filesystem::path& path);
-// JSON scene; `file_vertices` are the positions of the mesh's file vertices (for "centroid").
+std::vector<Eigen::Affine3d> parse_def(std::string_view text, std::string_view name);
+
+// JSON scene of the mesh read as `mesh` (for its file vertices, and which of them the mesh kept).
 // `options` are the defaults the scene's settings override.
+Scene read_scene(const std::filesystem::path& path, const MeshReadInfo& mesh,
+                 const DeformOptions& options = {});
+// The same for a mesh that kept every vertex of its file.
 Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertices,
                  const DeformOptions& options = {});
+// The same from the scene's text: `path` names it in messages and resolves the relative names of
+// the files it refers to, which `read_file` reads (it throws InputError for one it cannot read).
+using SceneFileReader = std::function<std::string(const std::filesystem::path&)>;
+Scene parse_scene(std::string_view text, const std::filesystem::path& path,
+                  const MeshReadInfo& mesh, const DeformOptions& options,
+                  const SceneFileReader& read_file);
 
-// The scene as JSON in the format above (vertex lists, 4 x 4 transforms, the fixed list and the
-// settings); read_scene() reads it back to the same selection, transforms and settings.
+// The mesh a JSON scene names (relative to the scene's directory), or an empty path.
+std::filesystem::path scene_mesh(const std::filesystem::path& path);
+
+// The scene as JSON in the format above (vertex lists, 4 x 4 transforms, the fixed list and all
+// the settings); read_scene() reads it back to the same selection, transforms and settings.
 std::string encode_scene(const Scene& scene);
 
 // `m` as an affine transform; throws InputError, `where` first, for one that is not finite, not
@@ -84,7 +107,12 @@ Selection radius_selection(const TriangleMesh& mesh, int center, double radius,
 // vertices are fixed, and the handle moves by 10% of the diagonal along the second-longest axis.
 Scene benchmark_scene(const TriangleMesh& mesh);
 
-// From file vertex indices to the loaded mesh's; vertices the reader dropped are left out.
-Selection to_mesh_numbering(const Selection& selection, const MeshReadInfo& info);
+// From file vertex indices to the loaded mesh's, leaving out the vertices the reader dropped
+// (used by no face). A handle group or fixed set that loses all its vertices is an InputError
+// naming it, `name` (the scene's) first; one that loses some adds a line to `notes`, if given
+// ("handle group 0: 3 of its 40 vertices are used by no face and were left out").
+Selection to_mesh_numbering(const Selection& selection, const MeshReadInfo& info,
+                            std::vector<std::string>* notes = nullptr,
+                            std::string_view name = "selection");
 
 }  // namespace specdeform
