@@ -55,6 +55,57 @@ expect 1 "$bin" deform "$tmp/p.off" --sel "$tmp/short.sel" --def "$tmp/p.def" -o
 printf '{"handles": [{"vertices": [9999]}]}' >"$tmp/bad.json"
 expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/bad.json" -o "$tmp/x.off"
 expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/scene.json" --constraints hard -m 3 -o "$tmp/x.off"
+# A scene that names its mesh, read without MESH.
+printf '{"mesh": "p.off", "handles": [{"vertices": [288], "transform": {"translate": [0, 0, 0.2]}}], "fixed": [0, 1]}' >"$tmp/named.json"
+expect 0 "$bin" deform --scene "$tmp/named.json" -m 30 -o "$tmp/named.off"
+# Scene fields of the wrong type: exit 1, one line naming the field (not an abort).
+check_error() {  # check_error FRAGMENT: the last command's stderr contains it
+  grep -qF -- "$1" "$tmp/err" || { echo "FAIL: expected '$1' in: $(cat "$tmp/err")"; fails=$((fails + 1)); }
+}
+printf '{"handles": [{"vertices": [288], "transform": {"rotate": {"axis": 5, "degrees": 10}}}]}' >"$tmp/axis.json"
+expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/axis.json" -o "$tmp/x.off"
+check_error "axis.json handle 0 transform rotate axis: expected an array of 3 numbers, got a number"
+printf '{"handles": [{"vertices": [288], "transform": {"rotate": 5}}]}' >"$tmp/rotate.json"
+expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/rotate.json" -o "$tmp/x.off"
+check_error "handle 0 transform rotate: expected an object, got a number"
+printf '{"handles": [{"vertices": [288]}], "settings": {"modes": "all"}}' >"$tmp/modes.json"
+expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/modes.json" -o "$tmp/x.off"
+check_error "settings modes: expected an integer, got a string"
+# --json: a failure is one JSON object on stdout too, with the exit code.
+expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/axis.json" -o "$tmp/x.off" --json
+grep -q '^{"error":".*rotate axis: expected an array of 3 numbers, got a number","exit_code":1}$' "$tmp/out" ||
+  { echo "FAIL: deform --json error: $(cat "$tmp/out")"; fails=$((fails + 1)); }
+expect 1 "$bin" info "$tmp/missing.off" --json
+grep -q '"exit_code":1' "$tmp/out" || { echo "FAIL: info --json error: $(cat "$tmp/out")"; fails=$((fails + 1)); }
+expect 2 "$bin" basis "$tmp/s.off" -m zero --json
+grep -q '"exit_code":2' "$tmp/out" || { echo "FAIL: basis --json error: $(cat "$tmp/out")"; fails=$((fails + 1)); }
+expect 1 "$bin" info "$tmp/missing.off"
+[ -s "$tmp/out" ] && { echo "FAIL: an error without --json printed on stdout"; fails=$((fails + 1)); }
+# Handle groups of vertices the reader dropped (a vertex no face uses, appended as vertex 289).
+awk 'NR == 2 { $1 = $1 + 1 } { print } NR == 291 { print "5 5 5" }' "$tmp/p.off" >"$tmp/unused.off"
+printf '{"handles": [{"vertices": [289]}], "fixed": [0]}' >"$tmp/dropped.json"
+# (after the reader's note on the vertex it dropped: two lines on stderr)
+"$bin" deform "$tmp/unused.off" --scene "$tmp/dropped.json" -m 30 -o "$tmp/x.off" 2>"$tmp/err"
+[ $? = 1 ] || { echo "FAIL: a handle group of dropped vertices only did not exit 1"; fails=$((fails + 1)); }
+check_error "handle group 0: all 1 of its vertices (file vertex 289 first) are used by no face"
+printf '{"handles": [{"vertices": [288, 289], "transform": {"translate": [0, 0, 0.2]}}], "fixed": [0]}' >"$tmp/partly.json"
+expect 0 "$bin" deform "$tmp/unused.off" --scene "$tmp/partly.json" -m 30 -o "$tmp/partly.off"
+check_error "partly.json: note: handle group 0: 1 of its 2 vertices are used by no face and were left out"
+# Files that are not what they claim: cut inside a face, a Git LFS pointer; triangle strips.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4' >"$tmp/cut.obj"
+expect 1 "$bin" info "$tmp/cut.obj"
+check_error "truncated: the file ends inside face 1"
+printf 'version https://git-lfs.github.com/spec/v1\noid sha256:0123\nsize 1234\n' >"$tmp/lfs.ply"
+expect 1 "$bin" info "$tmp/lfs.ply"
+check_error "lfs.ply: is a Git LFS pointer, not the mesh: run git lfs pull"
+printf 'ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\nproperty float z\nelement tristrips 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 2 0\n1 2 0\n9 0 2 1 3 -1 2 4 3 5\n' >"$tmp/strips.ply"
+expect 0 "$bin" info "$tmp/strips.ply" --json
+grep -q '"faces":4,' "$tmp/out" || { echo "FAIL: strips.ply: $(cat "$tmp/out")"; fails=$((fails + 1)); }
+# info names defects: a bow tie (two triangles sharing vertex 0 only, the second turned over).
+printf 'OFF\n5 2 0\n0 0 0\n1 0 0\n0 1 0\n-1 0 0\n0 -1 0\n3 0 1 2\n3 0 3 4\n' >"$tmp/bowtie.off"
+expect 0 "$bin" info "$tmp/bowtie.off" --json
+grep -q '"pinch_vertices":1,"first_pinch_vertex":0,' "$tmp/out" ||
+  { echo "FAIL: bowtie.off: $(cat "$tmp/out")"; fails=$((fails + 1)); }
 expect 0 "$bin" bench --quick --json "$tmp/bench.json" --markdown "$tmp/bench.md"
 grep -q '"PT1_basis"' "$tmp/bench.json" && grep -q '"spatial_prefactored_frame"' "$tmp/bench.json" ||
   { echo "FAIL: bench JSON lacks the Table 1 columns"; fails=$((fails + 1)); }
