@@ -139,6 +139,33 @@ TEST(IntrinsicDelaunay, NonManifoldSpineGluesFacingSides) {
   EXPECT_EQ(spine_halfedges, 6 * 3 * 2);  // 6 spine edges x 3 pages x 2 sides
 }
 
+TEST(IntrinsicDelaunay, TuftedCoverGluesNeighbouringPages) {
+  // Four pages at 0, 90, 180 and 270 degrees about the spine, stored in the order 0, 180, 90,
+  // 270: each side of a page faces the page 90 degrees away, never the one opposite.
+  const TriangleMesh four = test::book(4, 4, 0);
+  const int per_page = four.num_faces() / 4;
+  const int order[4] = {0, 2, 1, 3};  // the stored block b holds page order[b]
+  TriangleMesh mesh = four;
+  for (int b = 0; b < 4; ++b)
+    mesh.F.middleRows(b * per_page, per_page) = four.F.middleRows(order[b] * per_page, per_page);
+  const IntrinsicTriangulation tri = intrinsic_delaunay(mesh);
+  ASSERT_TRUE(tri.tufted);
+  const auto page = [&](int halfedge) {
+    return order[(halfedge / 3) % mesh.num_faces() / per_page];
+  };
+  int spine_halfedges = 0;
+  for (int t = 0; t < tri.F.rows(); ++t) {
+    for (int c = 0; c < 3; ++c) {
+      if (tri.F(t, c) > 4 || tri.F(t, (c + 1) % 3) > 4) continue;  // the spine is 0..4
+      ++spine_halfedges;
+      const int apart = (page(tri.twin(t, c)) - page(3 * t + c) + 4) % 4;
+      EXPECT_TRUE(apart == 1 || apart == 3)
+          << "pages " << page(3 * t + c) << ", " << page(tri.twin(t, c));
+    }
+  }
+  EXPECT_EQ(spine_halfedges, 4 * 4 * 2);  // 4 spine edges x 4 pages x 2 sides
+}
+
 TEST(IntrinsicDelaunay, FlatCapIsFlippedAway) {
   // A vertex q exactly on the diagonal a-b of a cell: the triangle (a, b, q) is flat (its angle
   // at q is pi) and carries nothing in the cotangent Laplacian; intrinsically the diagonal flips

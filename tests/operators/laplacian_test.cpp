@@ -115,7 +115,7 @@ TEST(Laplacian, SliversOfAFlatRectangle) {
   exact.resize(20);
   const TriangleMesh good = test::skewed_grid(32, 16, 2.0, 1.0, 0);
   const SpectrumError reference = spectrum_error(good, LaplacianType::Cotan, exact);
-  EXPECT_LT(reference.max, 0.03);
+  EXPECT_LT(reference.max, 0.04);
   // The same vertices in slivers leaning 4 cells (angles up to ~166 degrees).
   const TriangleMesh bad = test::skewed_grid(32, 16, 2.0, 1.0, 4);
   const SpectrumError cotan = spectrum_error(bad, LaplacianType::Cotan, exact);
@@ -145,7 +145,7 @@ TEST(Laplacian, NonManifoldBookSpectrum) {
   const SpectrumError cotan = spectrum_error(bad, LaplacianType::Cotan, exact);
   const SpectrumError intrinsic = spectrum_error(bad, LaplacianType::IntrinsicDelaunay, exact);
   EXPECT_GT(cotan.median, 0.2);
-  EXPECT_LT(intrinsic.max, 0.05);
+  EXPECT_LT(intrinsic.max, good.max * 1.01);
 }
 
 }  // namespace
