@@ -238,10 +238,13 @@ double double_area_or_zero(const IntrinsicTriangulation& tri, int t) {
   return degenerate(a, b, c) ? 0.0 : double_area(a, b, c);
 }
 
-// Half the cotangent of the angle opposite to corner c's edge of triangle t, 0 if degenerate.
-double half_cotangent(const IntrinsicTriangulation& tri, int t, int c) {
-  if (double_area_or_zero(tri, t) == 0.0) return 0.0;
-  return 0.5 * cotangent(tri.length(t, c), tri.length(t, (c + 1) % 3), tri.length(t, (c + 2) % 3));
+// Half the cotangent of the angle opposite to each corner's edge of triangle t; 0 if degenerate.
+Eigen::Array3d half_cotangents(const IntrinsicTriangulation& tri, int t) {
+  const double area = double_area_or_zero(tri, t);
+  if (area == 0.0) return Eigen::Array3d::Zero();
+  const Eigen::Array3d squared = tri.length.row(t).array().square().transpose();
+  // (b^2 + c^2 - a^2) / (4 A) for the edge a of each corner
+  return (squared.sum() - 2.0 * squared) / (4.0 * area);
 }
 
 }  // namespace
@@ -271,14 +274,10 @@ IntrinsicTriangulation intrinsic_delaunay(const TriangleMesh& mesh) {
   return out;
 }
 
-double corner_cotangent(const IntrinsicTriangulation& tri, int t, int c) {
-  return cotangent(tri.length(t, (c + 1) % 3), tri.length(t, (c + 2) % 3), tri.length(t, c));
-}
-
 double edge_weight(const IntrinsicTriangulation& tri, int t, int c) {
-  double w = half_cotangent(tri, t, c);
+  double w = half_cotangents(tri, t)[c];
   const int h = tri.twin(t, c);
-  if (h >= 0) w += half_cotangent(tri, h / 3, h % 3);
+  if (h >= 0) w += half_cotangents(tri, h / 3)[h % 3];
   return tri.sheet_weight * w;
 }
 
@@ -286,8 +285,9 @@ Sparse stiffness_matrix(const IntrinsicTriangulation& tri) {
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(12 * size_t(tri.F.rows()));
   for (int t = 0; t < tri.F.rows(); ++t) {
+    const Eigen::Array3d half_cot = tri.sheet_weight * half_cotangents(tri, t);
     for (int c = 0; c < 3; ++c) {
-      const double w = tri.sheet_weight * half_cotangent(tri, t, c);
+      const double w = half_cot[c];
       if (w == 0.0) continue;
       const int i = tri.F(t, c), j = tri.F(t, (c + 1) % 3);
       triplets.emplace_back(i, j, -w);

@@ -60,12 +60,9 @@ struct IntrinsicTriangulation {
 // pathological mesh), InputError for a face with a vertex index out of range.
 IntrinsicTriangulation intrinsic_delaunay(const TriangleMesh& mesh);
 
-// The angle of triangle t at corner c, as a cotangent from the lengths: +-infinity or NaN where
-// the triangle is degenerate.
-double corner_cotangent(const IntrinsicTriangulation& tri, int t, int c);
-
 // The cotangent weight of the edge of corner c of triangle t: (cot a + cot b) / 2 with a, b the
-// angles opposite to it (one on the boundary), times sheet_weight.
+// angles opposite to it (one on the boundary; a degenerate triangle's counts 0), times
+// sheet_weight. K_ij is minus the sum of the weights of the edges between i and j.
 double edge_weight(const IntrinsicTriangulation& tri, int t, int c);
 
 // The operators of linear finite elements on the triangulation, under the contract of
