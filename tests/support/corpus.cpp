@@ -37,7 +37,7 @@ std::vector<CorpusMesh> make_corpus() {
       {"torus_and_eye", Category::Components, concatenate(make_torus(1.0, 0.35, 36, 12), eye)});
   TriangleMesh stray;
   stray.V.resize(3, 3);
-  stray.V << 4.3, 0.0, 0.0, 4.35, 0.02, 0.0, 4.32, 0.05, 0.01;
+  stray.V << 4.3, 0.0, 0.0, 4.305, 0.002, 0.0, 4.302, 0.005, 0.001;
   stray.F.resize(1, 3);
   stray.F << 0, 1, 2;
   c.push_back(
