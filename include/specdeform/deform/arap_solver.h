@@ -86,6 +86,10 @@ class ArapSolver {
   ArapState solve(const SpatialSolver& solver, const SpatialSolver::Targets& targets,
                   ArapState start, ArapReport* report = nullptr) const;
 
+  // Spectral: H^T (K+ - K) H (m x m), what the membrane's dropped negative cotangent weights
+  // add to the reduced Hessian Lambda (zero where the mesh has none).
+  const Eigen::MatrixXd& membrane_correction() const { return membrane_correction_; }
+
   int clusters() const { return static_cast<int>(rest_.rows() / 3); }
   const Eigen::VectorXi& cluster_of_vertex() const { return label_; }
 
@@ -102,6 +106,7 @@ class ArapSolver {
   // Spectral: the same applied to the basis, Q = operator_ H (3k x m), Q^T and mean_ H (k x m).
   Eigen::MatrixXd reduced_, reduced_transposed_, reduced_mean_;
   Eigen::MatrixX3d rest_;  // S(s), 3k x 3
+  Eigen::MatrixXd membrane_correction_;
 };
 
 }  // namespace specdeform
