@@ -30,13 +30,15 @@ double peak_rss_mb() {
 }
 
 nlohmann::ordered_json bench_mesh(const std::string& name, const TriangleMesh& mesh, int modes,
-                                  int repeat, const ManifoldHarmonicsOptions& harmonics) {
+                                  int repeat, const ManifoldHarmonicsOptions& harmonics,
+                                  const DeformOptions& options) {
   const Scene scene = benchmark_scene(mesh);
   nlohmann::ordered_json j;
   j["mesh"] = name;
   j["vertices"] = mesh.num_vertices();
   j["faces"] = mesh.num_faces();
   j["modes"] = modes;
+  j["energy"] = specdeform::name(options.energy);
   j["handle_vertices"] = scene.selection.handles[0].size();
   j["fixed_vertices"] = scene.selection.fixed.size();
 
@@ -48,7 +50,7 @@ nlohmann::ordered_json bench_mesh(const std::string& name, const TriangleMesh& m
   if (basis.status != SolveStatus::Converged) throw SolverError(name + ": basis did not converge");
 
   clock = Stopwatch();
-  SpectralDeformer d(mesh, std::move(basis));
+  SpectralDeformer d(mesh, std::move(basis), options);
   const double analysis = d.setup_timings().detail_factorization;  // once per mesh
   d.set_selection(scene.selection);
   const SetupTimings& setup = d.setup_timings();
@@ -59,6 +61,7 @@ nlohmann::ordered_json bench_mesh(const std::string& name, const TriangleMesh& m
   j["inverse_transform"] = f.inverse_transform;
   j["RT2_detail"] = f.detail;
   j["frame"] = f.total;
+  j["iterations"] = d.arap_report().iterations;
   j["constraint_error_max"] = d.constraint_error(d.solve(scene.transforms)).max;
 
   // The spatial solve of the same energy on the detailed mesh (eq. 14): from scratch (its
@@ -119,6 +122,7 @@ void add_bench_command(CLI::App& app) {
     bool quick = false;
     TableOutputs tables;
     ManifoldHarmonicsOptions harmonics;
+    DeformArgs deform;
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("MESHES", args->meshes, "meshes to measure (default: generated bumpy bars)");
@@ -133,8 +137,11 @@ void add_bench_command(CLI::App& app) {
       ->check(CLI::Range(1, 100000));
   cmd->add_flag("--quick", args->quick, "small generated meshes, a few seconds (for tests)");
   args->tables.add_to(*cmd);
+  args->deform.add_to(*cmd);
   add_harmonics_options(*cmd, args->harmonics);
-  cmd->callback([args] {
+  cmd->callback([args, cmd] {
+    const DeformOptions options = args->deform.merged(*cmd, DeformOptions{});
+    options.validate();
     std::vector<std::pair<std::string, TriangleMesh>> meshes;
     for (const std::string& path : args->meshes) {
       meshes.emplace_back(std::filesystem::path(path).stem().string(), load_mesh(path).mesh);
@@ -156,7 +163,7 @@ void add_bench_command(CLI::App& app) {
         for (const int m : args->modes) {
           const int modes = args->quick ? std::min(m, 40) : m;
           std::cerr << "bench: " << label << ", m = " << modes << "\n";
-          rows.push_back(bench_mesh(label, measured, modes, repeat, args->harmonics));
+          rows.push_back(bench_mesh(label, measured, modes, repeat, args->harmonics, options));
         }
       }
     }

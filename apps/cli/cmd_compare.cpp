@@ -92,7 +92,8 @@ void add_compare_command(CLI::App& app) {
     std::vector<Method> methods;
     const auto ours = [&](const std::string& name, DeformOptions o) {
       std::cerr << "compare: " << name << "\n";
-      SpectralDeformer deformer(mesh, basis, o);
+      // The spatial solve deforms the detailed mesh itself (eq. 14), the others its base.
+      SpectralDeformer deformer(mesh, o.solver == DeformSolver::Spectral ? basis : nullptr, o);
       deformer.set_selection(loaded.selection);
       Method m{name};
       m.frame_ms = 1e3 * median_frame(deformer, transforms, args->repeat, &m.result).total;

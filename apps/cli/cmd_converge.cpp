@@ -41,7 +41,7 @@ void add_converge_command(CLI::App& app) {
     TableOutputs tables;
     SceneArgs scene;
     std::vector<int> modes{50, 100, 200, 300, 500, 900};
-    DeformOptions options;
+    DeformArgs deform;
     ManifoldHarmonicsOptions harmonics;
   };
   auto args = std::make_shared<Args>();
@@ -51,10 +51,15 @@ void add_converge_command(CLI::App& app) {
       ->check(CLI::Range(1, 100000));
   cmd->add_option("-o,--output", args->output, "folder for the deformed meshes (optional)");
   args->tables.add_to(*cmd);
+  args->deform.add_to(*cmd);
   add_harmonics_options(*cmd, args->harmonics);
-  cmd->callback([args] {
-    const LoadedScene s = load_scene(args->mesh, args->scene, args->options);
+  cmd->callback([args, cmd] {
+    const LoadedScene s = load_scene(args->mesh, args->scene, args->deform.options);
     const TriangleMesh& mesh = s.mesh.mesh;
+    DeformOptions options = args->deform.merged(*cmd, s.scene.options);
+    options.validate();
+    // Every check of the selection before the basis, which may take long.
+    constrained_set(s.selection, mesh, options.unconstrained, s.mesh.info.vertex_to_file);
     std::vector<int> modes = args->modes;
     std::sort(modes.begin(), modes.end());
     modes.erase(std::unique(modes.begin(), modes.end()), modes.end());
@@ -64,7 +69,7 @@ void add_converge_command(CLI::App& app) {
     const double diagonal = bounding_box_diagonal(mesh.V);
 
     // The spatial solution of the same energy and constraints (the smooth displacement's limit).
-    DeformOptions spatial = s.scene.options;
+    DeformOptions spatial = options;
     spatial.solver = DeformSolver::Spatial;
     spatial.detail = DetailMethod::None;
     SpectralDeformer reference(mesh, ManifoldHarmonics{}, spatial);
@@ -80,7 +85,7 @@ void add_converge_command(CLI::App& app) {
       ManifoldHarmonics truncated = full;
       truncated.basis.conservativeResize(Eigen::NoChange, m);
       truncated.eigenvalues.conservativeResize(m);
-      SpectralDeformer d(mesh, std::move(truncated), s.scene.options);
+      SpectralDeformer d(mesh, std::move(truncated), options);
       d.set_selection(s.selection);
       results.push_back(d.solve(s.scene.transforms));
       bases.push_back(d.deformed_base());

@@ -11,6 +11,7 @@
 #include <Eigen/SVD>
 
 #include "linalg/basis_product.h"
+#include "membrane_stiffness.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/vertex_clusters.h"
 #include "specdeform/operators/cotan_laplacian.h"
@@ -221,10 +222,10 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
   }
   const VertexClusters clusters = vertex_clusters(TriangleMesh{base, mesh.F}, options.clusters);
   label_ = clusters.label;
-  const Sparse K = cotan_stiffness(mesh);
+  const Sparse K = cotan_stiffness(mesh), membrane = detail::membrane_stiffness(K);
   const Eigen::VectorXd mass = lumped_mass(mesh);
   // Membrane and bending, as the linear energy's ks = 1 and kb = bending (unit-area scale).
-  const Sparse A = cluster_operator(K, base, label_, clusters.count) +
+  const Sparse A = cluster_operator(membrane, base, label_, clusters.count) +
                    (2.0 * options.bending * mass.sum()) *
                        bending_operator(K, mass, base, label_, clusters.count);
   rest_ = A * base;
@@ -236,6 +237,22 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
   Sparse cluster_mean(clusters.count, mesh.num_vertices());
   cluster_mean.setFromTriplets(mean.begin(), mean.end());
   if (basis) {
+    // H^T (K+ - K) H, summed over the dropped (negative-weight) pairs only.
+    const Eigen::MatrixXd& H = basis->basis;
+    std::vector<std::pair<int, int>> dropped;
+    std::vector<double> weight;
+    for (int j = 0; j < K.outerSize(); ++j) {
+      for (Sparse::InnerIterator it(K, j); it; ++it) {
+        if (it.row() < j && it.value() > 0.0) {
+          dropped.emplace_back(static_cast<int>(it.row()), j);
+          weight.push_back(std::sqrt(it.value()));
+        }
+      }
+    }
+    Eigen::MatrixXd differences(dropped.size(), H.cols());
+    for (size_t e = 0; e < dropped.size(); ++e)
+      differences.row(e) = weight[e] * (H.row(dropped[e].first) - H.row(dropped[e].second));
+    membrane_correction_ = differences.transpose() * differences;
     reduced_ = A * basis->basis;
     reduced_transposed_ = reduced_.transpose();
     reduced_mean_ = cluster_mean * basis->basis;

@@ -18,19 +18,19 @@ void check_sizes(const Vertices& a, const Vertices& b) {
   }
 }
 
-// Per face, +1 where its normal agrees with its edge neighbours' mean normal, -1 where it
-// points against it, 0 where either is undefined.
-std::vector<int> normal_agreement(const Vertices& V, const Faces& F,
-                                  const std::vector<std::vector<int>>& neighbours) {
+// Per face, the cosine between its normal and the area-weighted mean normal of its edge
+// neighbours (0 where either is undefined).
+std::vector<double> neighbour_agreement(const Vertices& V, const Faces& F,
+                                        const std::vector<std::vector<int>>& neighbours) {
   const TriangleMesh mesh{V, F};
   const Eigen::MatrixX3d normals = face_normals(mesh);
   const Eigen::VectorXd areas = face_areas(mesh);
-  std::vector<int> out(F.rows(), 0);
+  std::vector<double> out(F.rows(), 0.0);
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     Eigen::RowVector3d mean = Eigen::RowVector3d::Zero();
     for (const int g : neighbours[f]) mean += areas[g] * normals.row(g);
-    const double agreement = normals.row(f).dot(mean);
-    out[f] = agreement > 0 ? 1 : agreement < 0 ? -1 : 0;
+    const double length = mean.norm();
+    if (length > 0.0) out[f] = normals.row(f).dot(mean) / length;
   }
   return out;
 }
@@ -82,10 +82,10 @@ int inverted_faces(const TriangleMesh& rest, const Vertices& deformed) {
     for (const int f : faces)
       for (const int g : faces)
         if (f != g) neighbours[f].push_back(g);
-  const std::vector<int> before = normal_agreement(rest.V, rest.F, neighbours);
-  const std::vector<int> after = normal_agreement(deformed, rest.F, neighbours);
+  const std::vector<double> before = neighbour_agreement(rest.V, rest.F, neighbours);
+  const std::vector<double> after = neighbour_agreement(deformed, rest.F, neighbours);
   int count = 0;
-  for (int f = 0; f < rest.num_faces(); ++f) count += before[f] > 0 && after[f] < 0;
+  for (int f = 0; f < rest.num_faces(); ++f) count += before[f] > 0.5 && after[f] < 0.0;
   return count;
 }
 

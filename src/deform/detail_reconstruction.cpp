@@ -1,5 +1,8 @@
 #include "specdeform/deform/detail_reconstruction.h"
 
+#include <algorithm>
+#include <array>
+
 #include <Eigen/CholmodSupport>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -8,6 +11,7 @@
 #include "linalg/parallel.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/operators/cotan_laplacian.h"
+#include "specdeform/operators/mass_matrix.h"
 
 namespace specdeform {
 
@@ -38,6 +42,75 @@ Eigen::Matrix3d triangle_frame(const Vertices& V, const Faces& F, int f) {
   const Eigen::Vector3d n = (b - a).cross(c - a);
   m.col(2) = n.norm() > 0.0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
   return m;
+}
+
+// Whether a base triangle carries a deformation gradient worth transferring: it is not
+// collapsed (its larger singular value at least kMinRelativeSize of the detailed triangle's)
+// and not a sliver (its smaller singular value at least kMinAspect of its larger). Below that,
+// B'_f B_f^-1 amplifies rounding a thousandfold or more: a low-passed piece that collapsed to a
+// point (only its constant mode among the first m) gives pure noise.
+constexpr double kMinRelativeSize = 1e-3;
+constexpr double kMinAspect = 1e-3;
+
+// Singular values (larger, smaller) of the edge matrix [c - a, b - a] of face f.
+std::pair<double, double> edge_singular_values(const Vertices& V, const Faces& F, int f) {
+  Eigen::Matrix<double, 3, 2> E;
+  E.col(0) = V.row(F(f, 2)) - V.row(F(f, 0));
+  E.col(1) = V.row(F(f, 1)) - V.row(F(f, 0));
+  const Eigen::Matrix2d gram = E.transpose() * E;
+  const double half_trace = 0.5 * gram.trace();
+  const double root = std::sqrt(std::max(0.0, half_trace * half_trace - gram.determinant()));
+  return {std::sqrt(half_trace + root), std::sqrt(std::max(0.0, half_trace - root))};
+}
+
+// Per face, the face whose base deformation gradient it takes: itself where its base triangle is
+// sound, else the nearest sound face through shared edges (breadth first), or -1 where its
+// connected piece has none (its gradient is then the identity: the piece keeps its shape).
+std::vector<int> transfer_donors(const TriangleMesh& detailed, const Vertices& base) {
+  const int nf = detailed.num_faces();
+  std::vector<int> donor(nf, -1);
+  std::vector<int> queue;
+  for (int f = 0; f < nf; ++f) {
+    const double size = edge_singular_values(detailed.V, detailed.F, f).first;
+    const auto [large, small] = edge_singular_values(base, detailed.F, f);
+    if (large > kMinRelativeSize * size && small > kMinAspect * large) {
+      donor[f] = f;
+      queue.push_back(f);
+    }
+  }
+  if (static_cast<int>(queue.size()) == nf) return donor;
+  // The faces' edges, sorted, to walk from face to face: (smaller vertex, larger vertex, face).
+  std::vector<std::array<int, 3>> edges;
+  for (int f = 0; f < nf; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = detailed.F(f, k), b = detailed.F(f, (k + 1) % 3);
+      edges.push_back({std::min(a, b), std::max(a, b), f});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  std::vector<std::array<int, 3>> by_face(nf);  // each face's three entries in `edges`
+  std::vector<int> filled(nf, 0);
+  for (int e = 0; e < static_cast<int>(edges.size()); ++e) {
+    by_face[edges[e][2]][filled[edges[e][2]]++] = e;
+  }
+  const auto same_edge = [&](int e, int o) {
+    return edges[e][0] == edges[o][0] && edges[e][1] == edges[o][1];
+  };
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const int f = queue[head];
+    for (const int e : by_face[f]) {
+      int first = e;  // the faces sharing edge e are a run of equal (a, b)
+      while (first > 0 && same_edge(first - 1, e)) --first;
+      for (int o = first; o < static_cast<int>(edges.size()) && same_edge(o, e); ++o) {
+        const int g = edges[o][2];
+        if (donor[g] < 0) {
+          donor[g] = donor[f];
+          queue.push_back(g);
+        }
+      }
+    }
+  }
+  return donor;
 }
 
 }  // namespace
@@ -131,11 +204,25 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
       frame_neighbour_.assign(n, -1);
       for (int f = detailed.num_faces() - 1; f >= 0; --f)  // ends with the first incident face
         for (int k = 0; k < 3; ++k) frame_neighbour_[faces_(f, k)] = faces_(f, (k + 1) % 3);
+      // No frame where the base's one-ring collapsed (as for the transfer's triangles).
+      const Eigen::VectorXd area = lumped_mass(detailed);
+      const Eigen::VectorXd base_area = lumped_mass(TriangleMesh{base, faces_});
+      for (int i = 0; i < n; ++i) {
+        const int j = frame_neighbour_[i];
+        if (j < 0) continue;
+        const double edge = (detailed.V.row(j) - detailed.V.row(i)).norm();
+        if (!((base.row(j) - base.row(i)).norm() > kMinRelativeSize * edge &&
+              base_area[i] > kMinRelativeSize * kMinRelativeSize * area[i])) {
+          frame_neighbour_[i] = -1;
+        }
+      }
       const auto normals = vertex_normals(TriangleMesh{base, faces_});
       details_.resize(n, 3);
       for (int i = 0; i < n; ++i) {
+        const int j = frame_neighbour_[i];
         const Eigen::Matrix3d frame =
-            vertex_frame(normals.row(i), (base.row(frame_neighbour_[i]) - base.row(i)).transpose());
+            j < 0 ? Eigen::Matrix3d::Zero()
+                  : vertex_frame(normals.row(i), (base.row(j) - base.row(i)).transpose());
         // Where no frame exists the offset is kept as a plain displacement.
         details_.row(i) = frame.isZero() ? Eigen::RowVector3d(offset.row(i))
                                          : Eigen::RowVector3d(offset.row(i) * frame);
@@ -161,32 +248,34 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
       }
       std::stable_sort(face_order.begin(), face_order.end(),
                        [&](int a, int b) { return first[a] < first[b]; });
+      std::vector<int> slot(nf);  // face f of the mesh is face slot[f] here
+      for (int g = 0; g < nf; ++g) slot[face_order[g]] = g;
+      const std::vector<int> donors = transfer_donors(detailed, base);
       p.faces.resize(nf, 3);
       std::vector<Eigen::Triplet<double>> edges, normals;
       p.constant = RowMajor::Zero(n, 3);
       for (int g = 0; g < nf; ++g) {  // face g here is face f of the mesh
         const int f = face_order[g];
         for (int k = 0; k < 3; ++k) p.faces(g, k) = p.rank[faces_(f, k)];
-        const Eigen::Matrix3d m = triangle_frame(base, faces_, f);
-        bool invertible = false;
-        Eigen::Matrix3d inv = Eigen::Matrix3d::Zero();
-        m.computeInverseWithCheck(inv, invertible, 1e-300);
         Eigen::Matrix3d corners = Eigen::Matrix3d::Zero();  // rows: corners, columns: x, y, z
         for (int k = 0; k < 3; ++k)
           for (int d = 0; d < 3; ++d) corners(k, d) = G.coeff(3 * f + d, faces_(f, k));
         const Eigen::Matrix3d Q = areas[f] * corners * J.middleRows<3>(3 * f);
-        const int a = p.faces(g, 0), b = p.faces(g, 1), c = p.faces(g, 2);
-        if (!(invertible && m.col(2).squaredNorm() > 0)) {
+        const int donor = donors[f];
+        if (donor < 0) {  // S_f = I
           for (int r = 0; r < 3; ++r) p.constant.row(p.faces(g, r)) += Q.row(r);
           continue;
         }
-        const Eigen::Matrix3d P = Q * inv.transpose();
+        // S_f = B'_d B_d^-1 of the donor d (f itself where its base triangle is sound).
+        const Eigen::Matrix3d P = Q * triangle_frame(base, faces_, donor).inverse().transpose();
+        const int a = p.rank[faces_(donor, 0)], b = p.rank[faces_(donor, 1)],
+                  c = p.rank[faces_(donor, 2)];
         for (int r = 0; r < 3; ++r) {  // P(r, :) [c' - a', b' - a', n']^T
           const int v = p.faces(g, r);
           edges.emplace_back(v, c, P(r, 0));
           edges.emplace_back(v, b, P(r, 1));
           edges.emplace_back(v, a, -P(r, 0) - P(r, 1));
-          normals.emplace_back(v, g, P(r, 2));
+          normals.emplace_back(v, slot[donor], P(r, 2));
         }
       }
       p.edges.resize(n, n);
@@ -234,8 +323,10 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
       const auto normals = vertex_normals(TriangleMesh{s, faces_});
       Vertices out(s.rows(), 3);
       for (Eigen::Index i = 0; i < s.rows(); ++i) {
+        const int j = frame_neighbour_[i];
         const Eigen::Matrix3d frame =
-            vertex_frame(normals.row(i), (s.row(frame_neighbour_[i]) - s.row(i)).transpose());
+            j < 0 ? Eigen::Matrix3d::Zero()
+                  : vertex_frame(normals.row(i), (s.row(j) - s.row(i)).transpose());
         out.row(i) =
             s.row(i) + (frame.isZero() ? Eigen::RowVector3d(details_.row(i))
                                        : Eigen::RowVector3d(details_.row(i) * frame.transpose()));

@@ -11,7 +11,7 @@
 namespace specdeform {
 
 ReducedSolver::ReducedSolver(std::shared_ptr<const ManifoldHarmonics> basis,
-                             Eigen::VectorXd hessian, Eigen::VectorXd vertex_area,
+                             Eigen::MatrixXd hessian, Eigen::VectorXd vertex_area,
                              const DeformOptions& options)
     : basis_(std::move(basis)),
       hessian_(std::move(hessian)),
@@ -51,7 +51,7 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
     // Update the normal matrix by the vertices that changed, or rebuild it when many did.
     if (rebuild) {
       normal_ = columns_ * weights_.asDiagonal() * columns_.transpose();
-      normal_.diagonal() += hessian_;
+      normal_ += hessian_;
     } else {
       const auto update = [&](const std::vector<int>& changed, double sign) {
         Eigen::MatrixXd rows(changed.size(), m);
@@ -96,7 +96,7 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
     hard_free_ = Eigen::MatrixXd::Zero(m, m);
     return;
   }
-  const Eigen::MatrixXd DQ2 = hessian_.asDiagonal() * Q2;
+  const Eigen::MatrixXd DQ2 = hessian_ * Q2;
   const Eigen::LDLT<Eigen::MatrixXd> reduced(Q2.transpose() * DQ2);
   if (reduced.info() != Eigen::Success || !reduced.isPositive()) {
     throw SolverError("hard constraints: the energy does not determine the free modes");
@@ -144,7 +144,7 @@ double ReducedSolver::energy(const Targets& targets, const Eigen::MatrixX3d& c,
   // The Hessian's product Nc (soft: the normal matrix D + w H_C^T W H_C; hard: D).
   Eigen::MatrixX3d Nc;
   if (hard) {
-    Nc = hessian_.asDiagonal() * c;
+    Nc = hessian_.lazyProduct(c);
   } else {
     detail::add_basis_product(Eigen::MatrixX3d::Zero(c.rows(), 3), normal_, c, Nc);
   }

@@ -2,6 +2,7 @@
 
 #include <Eigen/CholmodSupport>
 
+#include "membrane_stiffness.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/operators/cotan_laplacian.h"
 #include "specdeform/operators/mass_matrix.h"
@@ -24,7 +25,8 @@ SpatialSolver::SpatialSolver(const TriangleMesh& mesh, const DeformOptions& opti
   const bool arap = options.energy == DeformEnergy::Arap;
   const double ks = arap ? 1.0 : options.ks, kb = arap ? options.arap.bending : options.kb;
   const Eigen::SparseMatrix<double> Dinv_K = mass.cwiseInverse().asDiagonal() * K;
-  A_ = ks * K + (kb * area) * Eigen::SparseMatrix<double>(K * Dinv_K);
+  A_ = ks * (arap ? detail::membrane_stiffness(K) : K) +
+       (kb * area) * Eigen::SparseMatrix<double>(K * Dinv_K);
   A_.makeCompressed();
 }
 

@@ -27,7 +27,8 @@ class Clock {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-// The reduced Hessian D of the energy (reduced_solver.h); eigenvalues of -1e-14 count as 0.
+// The diagonal of the reduced Hessian D (reduced_solver.h) without ARAP's correction for
+// negative cotangent weights; eigenvalues of -1e-14 count as 0.
 Eigen::VectorXd reduced_hessian(const ManifoldHarmonics& basis, double area,
                                 const DeformOptions& options) {
   const Eigen::ArrayXd lambda = basis.eigenvalues.array().max(0.0);
@@ -67,15 +68,17 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
     base_ = mesh_.V;
   }
   const bool spectral = options_.solver == DeformSolver::Spectral;
+  if (options_.energy == DeformEnergy::Arap) {
+    arap_ = std::make_unique<ArapSolver>(mesh_, base_, spectral ? basis_ : nullptr, options_.arap);
+  }
   if (spectral) {
-    reduced_ = std::make_unique<ReducedSolver>(
-        basis_, reduced_hessian(*basis_, area.sum(), options_), area / area.sum(), options_);
+    Eigen::MatrixXd hessian = reduced_hessian(*basis_, area.sum(), options_).asDiagonal();
+    if (arap_) hessian += arap_->membrane_correction();
+    reduced_ = std::make_unique<ReducedSolver>(basis_, std::move(hessian), area / area.sum(),
+                                               options_);
     if (options_.float32_basis) basis32_ = basis_->basis.cast<float>();
   } else {
     spatial_ = std::make_unique<SpatialSolver>(mesh_, options_);
-  }
-  if (options_.energy == DeformEnergy::Arap) {
-    arap_ = std::make_unique<ArapSolver>(mesh_, base_, spectral ? basis_ : nullptr, options_.arap);
   }
   setup_.reduced_system = clock.lap();
   details_ = std::make_unique<DetailReconstruction>(mesh_, base_, options_.detail);

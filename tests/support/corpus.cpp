@@ -28,7 +28,26 @@ std::vector<CorpusMesh> make_corpus() {
   c.push_back({"bumpy_plane", Category::Boundary, make_bumpy_plane(plane)});
   TriangleMesh shifted = make_icosphere(2);
   shifted.V.col(0).array() += 3.0;
-  c.push_back({"two_spheres", Category::Components, concatenate(make_icosphere(2), shifted)});
+  c.push_back({"two_spheres", Category::Components, concatenate(make_icosphere(2), shifted), 2});
+  // Pieces whose low-pass base collapses at m = 100 (only their constant mode): a small sphere
+  // beside a torus (an eye), a stray triangle beside a bar, a lid with a knob on a sphere.
+  TriangleMesh eye = make_icosphere(1, 0.05);
+  eye.V.col(0).array() += 1.5;
+  c.push_back(
+      {"torus_and_eye", Category::Components, concatenate(make_torus(1.0, 0.35, 36, 12), eye), 2});
+  TriangleMesh stray;
+  stray.V.resize(3, 3);
+  stray.V << 4.3, 0.0, 0.0, 4.305, 0.002, 0.0, 4.302, 0.005, 0.001;
+  stray.F.resize(1, 3);
+  stray.F << 0, 1, 2;
+  c.push_back(
+      {"bar_and_stray_triangle", Category::Components, concatenate(make_bumpy_bar(bar), stray), 2});
+  TriangleMesh lid = make_icosphere(2, 0.6), knob = make_icosphere(1, 0.1);
+  lid.V.col(2) *= 0.25;
+  lid.V.col(2).array() += 1.15;
+  knob.V.col(2).array() += 1.35;
+  c.push_back({"sphere_lid_and_knob", Category::Components,
+               concatenate(concatenate(make_icosphere(3), lid), knob), 3});
   // Awkward: a zero-area triangle on three collinear boundary vertices, and a fin on the edge
   // (0, 1), which then has three faces (non-manifold).
   TriangleMesh sliver = make_bumpy_plane({1.0, 12, 1, 0.0});

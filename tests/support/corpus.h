@@ -17,6 +17,7 @@ struct CorpusMesh {
   std::string name;
   Category category;
   TriangleMesh mesh;
+  int components = 1;  // connected components
 };
 
 // The generated corpus (each mesh has at most a few thousand vertices).

@@ -1,34 +1,39 @@
 // As-rigid-as-possible deformation of the smooth base (Sorkine & Alexa, "As-rigid-as-possible
-// surface modeling", 2007) with one rotation per vertex cluster, in the spectral subspace of
-// the manifold harmonics or over all vertices, accelerated by Anderson mixing with an energy
-// safeguard (Peng, Deng, Zhang & Liu, "Anderson acceleration for geometry optimization and
-// physics simulation", 2018).
+// surface modeling", 2007): the energy of deform_options.h made rotation-invariant, with one
+// rotation per vertex cluster, minimised in the spectral subspace of the manifold harmonics or
+// over all vertices.
 //
-// The energy of the deformed base s' = s + d (n x 3), with K's cotangent weights w_ij (K the
-// detailed mesh's stiffness matrix, so that the quadratic part is d's K-energy) and the
-// clusters of mesh/vertex_clusters.h (computed on s), is
-//     E(d, R) = 1/2 sum_i sum_{j ~ i} w_ij |(s'_i - s'_j) - R_k(i) (s_i - s_j)|^2
-//               + sum_{k < l} g_kl |R_k - R_l|_F^2 + constraints,
-// the second term smoothing the rotations between neighbouring clusters (as SR-ARAP, Levi &
-// Gotsman 2014, does between vertices): g_kl = beta A b_kl / (2 d_kl), A the surface area, b_kl
-// the length of the boundary between clusters k and l and d_kl the distance of their centroids
-// (a finite-volume Dirichlet energy of the rotation field, times beta A), beta =
-// ArapOptions::rotation_smoothness. It gives the surface a bending stiffness that ARAP alone
-// lacks: a strongly twisted bar keeps its cross-sections instead of necking.
-// With the cluster operator Q (3k x m: Q_k = sum_{i in k, j ~ i} w_ij (s_i - s_j)(h_i - h_j)^T,
-// H the basis; over all vertices the sparse 3k x n operator with unit vectors for h) and d = H c:
-//  - local step: the covariance of cluster k is S_k = S_k(s) + Q_k c (3 x 3), and R_k maximises
-//    tr(R_k (S_k + 2 sum_l g_kl R_l^T)) (SVD, reflections excluded), the clusters in turn with
-//    their neighbours' latest rotations (block coordinate descent): O(k m) per iteration;
-//  - global step: the minimiser of tr(c^T Lambda c) - 2 tr(c^T g) + constraints with
-//    g = 1/2 Q^T (R - I) (the blocks R_k^T - I stacked), one solve of the m x m system that
-//    ReducedSolver factors once per selection (D = Lambda): O(m^2) per iteration.
-// Each iteration is O(k m + m^2), independent of n. The energy tracked is E up to a term of
-// the order of the basis's eigen-residual (Lambda stands for H^T K H), minimised exactly by
-// each step: it never increases (Anderson steps that would raise it are rejected). Stops when
-// an iteration lowers the energy by less than `tolerance` times the energy, when the energy
-// falls below 1e-14 of its starting value, or at `max_iterations`. Energies are in the units
-// of the mesh's lengths squared, on the unit-area scale of deform_options.h.
+// The energy of the deformed base s' = s + d (n x 3), the clusters those of
+// mesh/vertex_clusters.h computed on s, R_k(i) the rotation of vertex i's cluster:
+//     E(d, R) = 1/2 sum_i sum_{j ~ i} w+_ij |(s'_i - s'_j) - R_k(i) (s_i - s_j)|^2      membrane
+//             + b A sum_i a_i |(M^-1 K s')_i - R_k(i) (M^-1 K s)_i|^2                    bending
+//             + constraints,
+// K the detailed mesh's cotangent stiffness matrix, M its lumped mass (a_i), A its area,
+// w+_ij = max(w_ij, 0) (negative weights would make a cluster's rest covariance indefinite and
+// the rest pose no minimum), b = ArapOptions::bending. The membrane term keeps edge vectors, the
+// bending term mean-curvature normals, each turned by its cluster's rotation; with every
+// R_k = I the energy is the paper's linear one (ks = 1, kb = b, K+ for the membrane). The
+// bending term gives the surface the stiffness against bending and necking that the membrane
+// alone lacks (a bent bar keeps its cross-sections).
+//
+// With d = H c and the cluster operator Q (3k x m; over all vertices the sparse 3k x n operator
+// with the identity for H), the covariance of cluster k is S_k = S_k(s) + Q_k c (3 x 3) and
+//     E(c, R) = tr(c^T D c) - sum_k tr((R_k - I) S_k) + constraints + const,
+// D = Lambda + b A Lambda^2 + H^T (K+ - K) H the reduced Hessian that ReducedSolver factors once
+// per selection (reduced_solver.h):
+//  - local step: R_k maximises tr(R_k S_k) (a closed-form polar decomposition, reflections
+//    excluded): O(k m) per iteration;
+//  - the energy's gradient in c, with the rotations optimal for c, is 2 (D c - 1/2 Q^T (R - I))
+//    plus the constraints' (the blocks R_k^T - I stacked), and the global step c - D'^-1 (...),
+//    D' = D with the soft constraints, minimises E for fixed rotations: O(m^2) per iteration.
+// The iterations are L-BFGS with the global step's matrix as the initial inverse Hessian (Liu,
+// Bouaziz & Kavan, "Quasi-Newton methods for real-time simulation of hyperelastic materials",
+// 2017): without history a step is the local/global step; a step that fails the Armijo condition
+// is replaced by the local/global step, so the energy never increases. Each iteration is
+// O(k m + m^2), independent of n. They stop when an iteration lowers the energy by less than
+// `tolerance` times the energy, when the energy falls below 1e-14 of its starting value, or at
+// `max_iterations`. Energies are in the units of the mesh's lengths squared, on the unit-area
+// scale of deform_options.h.
 #pragma once
 
 #include <memory>
@@ -86,6 +91,10 @@ class ArapSolver {
   ArapState solve(const SpatialSolver& solver, const SpatialSolver::Targets& targets,
                   ArapState start, ArapReport* report = nullptr) const;
 
+  // Spectral: H^T (K+ - K) H (m x m), what the membrane's dropped negative cotangent weights
+  // add to the reduced Hessian Lambda (zero where the mesh has none).
+  const Eigen::MatrixXd& membrane_correction() const { return membrane_correction_; }
+
   int clusters() const { return static_cast<int>(rest_.rows() / 3); }
   const Eigen::VectorXi& cluster_of_vertex() const { return label_; }
 
@@ -102,6 +111,7 @@ class ArapSolver {
   // Spectral: the same applied to the basis, Q = operator_ H (3k x m), Q^T and mean_ H (k x m).
   Eigen::MatrixXd reduced_, reduced_transposed_, reduced_mean_;
   Eigen::MatrixX3d rest_;  // S(s), 3k x 3
+  Eigen::MatrixXd membrane_correction_;
 };
 
 }  // namespace specdeform

@@ -6,10 +6,10 @@
 //    form,  E(d) = ks d^T K d + kb d^T K M^-1 K d,  K the cotangent stiffness matrix, M the mass
 //    matrix. One linear solve per frame, but it cannot rotate: a turned handle shrinks the
 //    surface between it and the fixed part (the "candy wrapper").
-//  - Arap: as-rigid-as-possible (Sorkine & Alexa 2007) on the smooth base's edges, with one
-//    rotation per cluster of vertices instead of one per vertex,
-//        E(s') = 1/2 sum_i sum_{j ~ i} w_ij |(s'_i - s'_j) - R_k(i) (s_i - s_j)|^2,
-//    w_ij the cotangent weights of K; minimised by local/global iterations (arap_solver.h).
+//  - Arap: as-rigid-as-possible (Sorkine & Alexa 2007): the same energy with its rest edge
+//    vectors (stretching) and mean-curvature normals (bending) turned by one rotation per
+//    cluster of vertices, minimised by quasi-Newton local/global iterations (arap_solver.h).
+//    It keeps the shape under large rotations; the default.
 // Soft constraints add  w sum_{i in C} a_i |s'_i - t_i|^2,  a_i the vertex's lumped area on the
 // unit-area scale (so w does not depend on resolution).
 #pragma once
@@ -20,7 +20,7 @@ namespace specdeform {
 
 enum class DeformEnergy {
   Linear,  // the paper's linearised thin shell: one solve per frame, no rotation
-  Arap,    // as-rigid-as-possible, one rotation per vertex cluster: local/global iterations
+  Arap,    // as-rigid-as-possible, one rotation per vertex cluster: iterations per frame
 };
 
 enum class ConstraintMode {
@@ -29,7 +29,7 @@ enum class ConstraintMode {
 };
 
 enum class DeformSolver {
-  Spectral,  // in the span of the first m manifold harmonics (reduced, diagonal Hessian)
+  Spectral,  // in the span of the first m manifold harmonics (an m x m Hessian)
   Spatial,   // over all n vertices, prefactored with CHOLMOD (the reference, paper eq. 14)
 };
 
@@ -46,16 +46,17 @@ enum class UnconstrainedPieces {
   Error,  // is an InputError naming the piece
 };
 
-// The local/global iterations of DeformEnergy::Arap.
+// DeformEnergy::Arap: its bending weight, rotation clusters and iterations.
 struct ArapOptions {
   int clusters = 200;        // rotation clusters (at least one per connected component)
   double bending = 1e-3;     // the bending weight against the membrane's 1 (arap_solver.h)
   int max_iterations = 100;  // a cap on the iterations per frame
   double tolerance = 1e-4;   // stop when an iteration lowers the energy by less than this
-                             // fraction of the energy's scale (see arap_solver.h)
+                             // fraction of it (see arap_solver.h)
   int history = 5;           // L-BFGS pairs kept; 0: plain local/global steps
-  bool warm_start = false;   // start from the previous frame's solution instead of the rest
-                             // pose (interactive drags; not for timing a cold frame)
+  bool warm_start = false;   // start from the previous frame's solution instead of the
+                             // handles' rotations spread over the surface (interactive drags;
+                             // not for timing a cold frame)
 };
 
 struct DeformOptions {

@@ -5,9 +5,11 @@
 //    vertices, the caps' interiors, are skipped), each ring's mean distance to its centroid
 //    after over before, in the order of the coordinate. 1: the cross-section keeps its size; the
 //    linear energy's twisted bars fall to 0.25-0.4 (the candy wrapper).
-//  - inverted_faces(): faces whose normal points against the area-weighted mean normal of their
-//    edge neighbours after the deformation but not before: local fold-overs. A rigid motion or
-//    a smooth bend has none.
+//  - inverted_faces(): faces that agreed with their edge neighbours before the deformation (the
+//    normal within 60 degrees of their area-weighted mean normal) and point against it after:
+//    local fold-overs. Faces on sharp features (nearly perpendicular to their neighbours) are
+//    left out, where a harmless wobble would flip the sign. A rigid motion or a smooth bend has
+//    none.
 //  - point_distances(): the RMS and the largest distance between corresponding vertices.
 #pragma once
 

@@ -15,6 +15,13 @@
 //                  anchor set and then updated by the anchors that change (row additions and
 //                  deletions); a frame is O(f) plus one back-substitution with 3 columns, both
 //                  on two threads.
+// Where the low-pass collapsed the base (a small piece keeps only its constant mode among the
+// first m and its base is a point; thin tips and slivers nearly so), a base triangle's or
+// one-ring's frame is rounding noise. Such a triangle (its base edges below 1e-3 of the detailed
+// ones, or its base a sliver of aspect below 1e-3) takes the deformation gradient of the
+// nearest sound triangle of its piece, or the identity where its piece has none (the piece
+// keeps its shape and follows its anchors); such a vertex keeps its offset as a displacement
+// (Frames).
 // With s' = s every method returns x (to round-off).
 #pragma once
 

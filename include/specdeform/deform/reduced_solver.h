@@ -2,9 +2,10 @@
 // done as in the technical notes rather than literally).
 //
 // With d = H c, H the n x m manifold harmonics (H^T M H = I, mesh units), every energy of
-// deform_options.h has a diagonal reduced Hessian D (m), the same for x, y and z:
-//     linear:  D = ks Lambda + kb A Lambda^2     (A = surface area: unit-area scaling)
-//     ARAP:    D = Lambda                        (its global step; arap_solver.h)
+// deform_options.h has a reduced Hessian D (m x m), the same for x, y and z:
+//     linear:  D = ks Lambda + kb A Lambda^2     (A = surface area: unit-area scaling; diagonal)
+//     ARAP:    D = Lambda + b A Lambda^2 + H^T (K+ - K) H   (its global step; arap_solver.h:
+//              dense where the mesh has negative cotangent weights, else diagonal)
 // This solver minimises, over the coefficients c (m x 3),
 //     E(c) = tr(c^T D c) - 2 tr(c^T g) + constraints
 // for a linear term g (m x 3; zero for the linear energy). No n x n product is ever formed.
@@ -30,8 +31,9 @@ namespace specdeform {
 
 class ReducedSolver {
  public:
-  // hessian: D (m, >= 0); vertex_area: lumped mass (n) on the unit-area scale.
-  ReducedSolver(std::shared_ptr<const ManifoldHarmonics> basis, Eigen::VectorXd hessian,
+  // hessian: D (m x m, symmetric positive semidefinite); vertex_area: lumped mass (n) on the
+  // unit-area scale.
+  ReducedSolver(std::shared_ptr<const ManifoldHarmonics> basis, Eigen::MatrixXd hessian,
                 Eigen::VectorXd vertex_area, const DeformOptions& options);
 
   // Factors the reduced system for these constrained vertices.
@@ -63,14 +65,14 @@ class ReducedSolver {
   // c (that meets the hard constraints).
   Eigen::MatrixX3d precondition(const Eigen::MatrixX3d& v) const;
 
-  const Eigen::VectorXd& hessian() const { return hessian_; }
+  const Eigen::MatrixXd& hessian() const { return hessian_; }
 
  private:
   // The soft constraint's weight of a vertex: constraint_weight times its (unit-scale) area.
   double weight(int vertex) const { return options_.constraint_weight * vertex_area_[vertex]; }
 
   std::shared_ptr<const ManifoldHarmonics> basis_;
-  Eigen::VectorXd hessian_;
+  Eigen::MatrixXd hessian_;
   Eigen::VectorXd vertex_area_;  // on the unit-area scale
   DeformOptions options_;
   Eigen::MatrixXd columns_;     // H_C^T, m x n'

@@ -5,7 +5,8 @@
 // Over the displacement d (n x 3) it minimises
 //     E(d) = tr(d^T A d) - 2 tr(d^T g) + constraints,
 //   A = ks K + kb A_s K D^-1 K   (linear energy; D the lumped mass, A_s the surface area)
-//   A = K                        (ARAP's global step; arap_solver.h)
+//   A = K+ + b A_s K D^-1 K      (ARAP's global step, K+ without negative weights;
+//                                 arap_solver.h)
 // for a linear term g (n x 3; zero for the linear energy):
 //   hard: Dirichlet conditions d_C = t, A_FF d_F = g_F - A_FC t
 //   soft: (A + w W) d = w W t + g, W = a_i on the constrained vertices
