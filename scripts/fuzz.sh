@@ -7,12 +7,14 @@ seconds=${1:-60}
 if ! command -v clang++ >/dev/null; then
   echo "fuzz: clang++ not installed, skipped"; exit 0
 fi
+targets="mesh_readers scene editor_messages"
 CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=Release -DSPECDEFORM_BUILD_FUZZERS=ON \
-  -DSPECDEFORM_BUILD_TESTS=OFF -DSPECDEFORM_BUILD_BENCHMARKS=OFF -DSPECDEFORM_BUILD_CLI=OFF >/dev/null
-cmake --build build-fuzz -j "$(nproc)" >/dev/null
+  -DSPECDEFORM_BUILD_TESTS=OFF -DSPECDEFORM_BUILD_BENCHMARKS=OFF -DSPECDEFORM_BUILD_CLI=OFF \
+  -DSPECDEFORM_BUILD_PYTHON=OFF >/dev/null
+cmake --build build-fuzz -j "$(nproc)" --target $(printf 'fuzz_%s ' $targets) >/dev/null
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-for target in mesh_readers editor_messages; do
+for target in $targets; do
   mkdir "$work/$target"
   cp fuzz/corpus/$target/* "$work/$target/"
   build-fuzz/bin/fuzz_$target "$work/$target" -max_total_time="$seconds" -max_len=4096 \
