@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Regenerates docs/results/: the paper's Table 1, Fig. 5 and Fig. 6 measured on this machine,
-# and pictures of the pipeline (original, smooth base, deformed base, detailed result).
+# pictures of the pipeline (original, smooth base, deformed base, detailed result), and the
+# intrinsic Delaunay Laplacian against the cotan one on every shared model.
 # Needs ../shared/meshes (the test meshes) and a build (scripts/setup.sh); installs
 # python3-matplotlib for the plot and chromium for the pictures where missing.
-# Usage: scripts/reproduce.sh [OUT]     (default: docs/results; takes about 15 minutes)
+# Usage: scripts/reproduce.sh [OUT]     (default: docs/results; takes about 25 minutes)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-docs/results}
@@ -50,6 +51,12 @@ pipeline() {  # pipeline NAME MESH SCENE-ARGS...
 }
 pipeline armadillo "$arm" --scene "$hand"
 pipeline bar_bend "$scenes/bar-bend.off" --sel "$scenes/bar-bend.sel" --def "$scenes/bar-bend.def"
+
+echo "== A robust Laplacian: each Laplacian's eigenvalues against a finer remeshing"
+for mass in lumped consistent; do
+  build/bin/laplacian_agreement --mass $mass --json "$out/laplacian_$mass.json" \
+    --markdown "$out/laplacian_$mass.md"
+done
 
 echo "== pictures"
 jobs="["
