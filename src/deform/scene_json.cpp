@@ -35,6 +35,11 @@ std::string kind(const Json& j) {
   }
 }
 
+// Whether a key or string can go into a one-line message as it is.
+bool printable(std::string_view s) {
+  return std::none_of(s.begin(), s.end(), [](unsigned char c) { return c < 0x20 || c == 0x7f; });
+}
+
 // A value of the scene with its place in it ("s.json handle 0 transform"). Every field is read
 // through one: a missing field, an unknown key, or a value of the wrong type names the field and
 // what was expected.
@@ -58,6 +63,7 @@ class Field {
     if (!j_.is_object()) expected("an object");
     for (const auto& item : j_.items()) {
       if (std::find(keys.begin(), keys.end(), item.key()) != keys.end()) continue;
+      if (!printable(item.key())) fail("a key with control characters");
       std::string known;
       for (const std::string_view k : keys) known += (known.empty() ? "" : ", ") + std::string(k);
       fail("unknown key '" + item.key() + "' (known: " + known + ")");
@@ -103,7 +109,9 @@ class Field {
   }
   std::string string() const {
     if (!j_.is_string()) expected("a string");
-    return j_.get<std::string>();
+    const std::string s = j_.get<std::string>();
+    if (!printable(s)) fail("the string has control characters");
+    return s;
   }
   Eigen::Vector3d vec3() const {
     if (!j_.is_array() || j_.size() != 3 ||

@@ -1,4 +1,5 @@
 #include <bit>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -275,10 +276,11 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name) {
           if (!is_face && !is_strip) continue;
           if (!(v >= (is_strip ? -1 : 0) && v < static_cast<double>(vertex->count)) ||
               v != std::floor(v)) {
+            char text[32];  // v as read: it may be 1.5, 1e300 or nan
+            const auto [end, ec] = std::to_chars(text, text + sizeof text, v);
             throw InputError(name + ": " + (is_face ? "face " : "triangle strip ") +
-                             std::to_string(r) + " references vertex " +
-                             std::to_string(static_cast<long long>(v)) + " but there are " +
-                             std::to_string(vertex->count) + " vertices");
+                             std::to_string(r) + " references vertex " + std::string(text, end) +
+                             " but there are " + std::to_string(vertex->count) + " vertices");
           }
           if (is_face) {
             soup.add_polygon_corner(static_cast<int>(v));

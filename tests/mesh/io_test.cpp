@@ -327,6 +327,11 @@ TEST(MeshIo, ClearErrors) {
   truncated.resize(truncated.size() - 20);
   expect_error(truncated, MeshFormat::Ply, "truncated");
   expect_error("ply\nformat ascii 1.0\n", MeshFormat::Ply, "end_header");
+  expect_error(
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n3 0 1 1e300\n",
+      MeshFormat::Ply, "face 0 references vertex 1e+300 but there are 3 vertices");
   std::string stl = encode_mesh(make_icosphere(0), MeshFormat::Stl);
   stl.resize(stl.size() - 10);
   expect_error(stl, MeshFormat::Stl, "truncated binary STL");
