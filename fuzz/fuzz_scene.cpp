@@ -1,6 +1,6 @@
 // Feeds arbitrary bytes to the scene readers; the first byte picks the format (JSON, .sel, .dmat,
-// .def). Each must return its result or throw InputError. A JSON scene that reads must also read
-// back, as encode_scene() writes it, to the same selection, transforms and settings.
+// .def). Each must return its result or throw InputError of one line. A JSON scene that reads must
+// also read back, as encode_scene() writes it, to the same selection, transforms and settings.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -34,6 +34,11 @@ std::string read_file(const std::filesystem::path& path) {
   if (path.filename() == "h.sel") return "# status\n0\n0\n1\n1\n1\n1\n1\n1\n1\n2\n2\n2\n";
   if (path.filename() == "h.dmat") return "1 12\n0\n0\n-1\n-1\n1\n1\n-1\n-1\n-1\n2\n2\n2\n";
   throw sd::InputError(path.string() + ": cannot open file");
+}
+
+// Errors are one line.
+void one_line(const sd::InputError& e) {
+  if (std::string_view(e.what()).find('\n') != std::string_view::npos) std::abort();
 }
 
 void round_trip(const sd::Scene& scene) {
@@ -71,14 +76,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         sd::parse_def(text, "fuzz.def");
         return 0;
     }
-  } catch (const sd::InputError&) {
+  } catch (const sd::InputError& e) {
+    one_line(e);
     return 0;
   }
   round_trip(scene);  // outside the try: a scene that read must read back
   try {
     std::vector<std::string> notes;
     sd::to_mesh_numbering(scene.selection, mesh(), &notes, "fuzz");
-  } catch (const sd::InputError&) {
+  } catch (const sd::InputError& e) {
+    one_line(e);
   }
   return 0;
 }
