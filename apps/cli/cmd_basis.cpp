@@ -44,6 +44,8 @@ void add_basis_command(CLI::App& app) {
       j["seconds"] = seconds;
       j["converged"] = converged;
       j["max_residual"] = h.max_residual;
+      j["threshold"] = h.threshold;
+      j["rounding_floor"] = h.rounding_floor;
       j["max_orthogonality_error"] = h.max_orthogonality_error;
       j["cluster_truncated"] = h.cluster_truncated;
       j["bands"] = h.bands;
@@ -60,8 +62,7 @@ void add_basis_command(CLI::App& app) {
       if (!args->output.empty() && converged) std::cout << "wrote " << args->output << "\n";
     }
     if (!converged) {
-      throw SolverError("manifold harmonics did not converge: " +
-                        residual_summary(h, args->options.tolerance));
+      throw SolverError("manifold harmonics did not converge: " + residual_summary(h));
     }
   });
 }

@@ -265,8 +265,7 @@ ManifoldHarmonics obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonics
   o.progress = progress_bar("manifold harmonics");
   ManifoldHarmonics h = compute_manifold_harmonics(mesh, o);
   if (h.status != SolveStatus::Converged) {
-    throw SolverError("manifold harmonics did not converge: " +
-                      residual_summary(h, options.tolerance));
+    throw SolverError("manifold harmonics did not converge: " + residual_summary(h));
   }
   if (h.cluster_truncated) {
     std::cerr << "note: m = " << options.num_modes

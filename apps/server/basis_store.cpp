@@ -42,11 +42,9 @@ PreparedBasis prepare_basis(const TriangleMesh& mesh, int modes,
       // Short of the tolerance but far below what a deformation can show (nearly degenerate
       // triangles limit the attainable accuracy): usable, with a warning; not cached.
       if (!(basis->max_residual <= kUsableResidual)) {
-        throw SolverError("the manifold harmonics did not converge: " +
-                          residual_summary(*basis, o.tolerance));
+        throw SolverError("the manifold harmonics did not converge: " + residual_summary(*basis));
       }
-      out.warning =
-          "the basis is less accurate than asked: " + residual_summary(*basis, o.tolerance);
+      out.warning = "the basis is less accurate than asked: " + residual_summary(*basis);
     } else if (!cache.empty()) {
       try {
         std::filesystem::create_directories(cache.parent_path());

@@ -93,6 +93,7 @@ returns (evecs.base). SpectralDeformer shares it without a copy.)")
                              [](const Harmonics& h) { return h.value->max_residual; })
       .def_property_readonly("rounding_floor",
                              [](const Harmonics& h) { return h.value->rounding_floor; })
+      .def_property_readonly("threshold", [](const Harmonics& h) { return h.value->threshold; })
       .def_property_readonly("max_orthogonality_error",
                              [](const Harmonics& h) { return h.value->max_orthogonality_error; })
       .def_property_readonly("cluster_truncated",

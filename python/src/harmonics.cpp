@@ -156,8 +156,7 @@ std::shared_ptr<const ManifoldHarmonics> obtain_basis(
     *h = compute_manifold_harmonics(mesh, o);
   }
   if (h->status != SolveStatus::Converged) {
-    throw SolverError("manifold harmonics did not converge: " +
-                      residual_summary(*h, options.tolerance));
+    throw SolverError("manifold harmonics did not converge: " + residual_summary(*h));
   }
   if (h->cluster_truncated) {
     const std::string message =

@@ -3,6 +3,7 @@
 #include <bit>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -14,8 +15,9 @@ namespace specdeform {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'D', 'B', 'A', 'S', 'I', 'S', '\0'};
-constexpr uint32_t kVersion = 2;  // version 1: no Laplacian byte (cotan)
+constexpr uint32_t kVersion = 3;  // 1: no Laplacian byte (cotan); 1 and 2: no solver report
 constexpr size_t kHeaderSize = 8 + 4 + 4 + 4 + 1 + 1 + 1 + 1 + 8;
+constexpr size_t kReportSize = 4 * 8 + 4 + 4 + 8 + 8;
 
 static_assert(std::endian::native == std::endian::little, "the cache format is little-endian");
 
@@ -57,7 +59,7 @@ void save_basis(const std::filesystem::path& path, const ManifoldHarmonics& basi
   }
   const bool single = precision == BasisPrecision::Float32;
   std::string out;
-  out.reserve(kHeaderSize + 8 * size_t(m) + (single ? 4 : 8) * size_t(n) * m);
+  out.reserve(kHeaderSize + kReportSize + 8 * size_t(m) + (single ? 4 : 8) * size_t(n) * m);
   out.append(kMagic, 8);
   put(out, kVersion);
   put(out, n);
@@ -67,6 +69,16 @@ void save_basis(const std::filesystem::path& path, const ManifoldHarmonics& basi
   put(out, static_cast<uint8_t>(basis.laplacian == LaplacianType::Cotan ? 0 : 1));
   put(out, uint8_t{0});
   put(out, mesh_hash(mesh));
+  put(out, basis.max_residual);
+  put(out, basis.rounding_floor);
+  put(out, basis.threshold);
+  put(out, basis.max_orthogonality_error);
+  put(out, static_cast<uint32_t>(basis.bands));
+  put(out, static_cast<uint32_t>(basis.restarts));
+  put(out, static_cast<uint64_t>(basis.solves));
+  put(out, static_cast<uint8_t>(basis.status == SolveStatus::Converged ? 1 : 0));
+  put(out, static_cast<uint8_t>(basis.cluster_truncated ? 1 : 0));
+  out.append(6, '\0');
   out.append(reinterpret_cast<const char*>(basis.eigenvalues.data()), 8 * size_t(m));
   if (single) {
     const Eigen::MatrixXf H = basis.basis.cast<float>();
@@ -86,7 +98,7 @@ ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMe
   if (std::memcmp(header, kMagic, 8) != 0) throw InputError(name + ": not a specdeform basis file");
   const char* p = header + 8;
   const auto version = get<uint32_t>(p);
-  if (version != 1 && version != kVersion) {
+  if (version < 1 || version > kVersion) {
     throw InputError(name + ": basis file version " + std::to_string(version) +
                      " is not supported (this build reads versions 1 to " +
                      std::to_string(kVersion) + ")");
@@ -106,6 +118,22 @@ ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMe
     throw InputError(name + ": corrupt basis header");
   }
   ManifoldHarmonics out;
+  if (version >= 3) {
+    char report[kReportSize];
+    if (!file.read(report, kReportSize)) throw InputError(name + ": truncated basis file");
+    const char* r = report;
+    out.max_residual = get<double>(r);
+    out.rounding_floor = get<double>(r);
+    out.threshold = get<double>(r);
+    out.max_orthogonality_error = get<double>(r);
+    out.bands = static_cast<int>(get<uint32_t>(r));
+    out.restarts = static_cast<int>(get<uint32_t>(r));
+    out.solves = static_cast<long long>(get<uint64_t>(r));
+    out.status = get<uint8_t>(r) == 1 ? SolveStatus::Converged : SolveStatus::NotConverged;
+    out.cluster_truncated = get<uint8_t>(r) == 1;
+  } else {
+    out.max_residual = std::numeric_limits<double>::quiet_NaN();  // not recorded
+  }
   out.mass = mass == 0 ? MassType::Lumped : MassType::Consistent;
   out.laplacian = laplacian == 0 ? LaplacianType::Cotan : LaplacianType::IntrinsicDelaunay;
   out.eigenvalues.resize(m);

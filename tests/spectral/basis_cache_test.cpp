@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/generate.h"
@@ -68,25 +71,52 @@ TEST_F(BasisCache, RecordsTheLaplacian) {
       InputError);
 }
 
-TEST_F(BasisCache, ReadsVersionOneAsCotan) {
-  // Version 1 had a reserved zero where version 2 keeps the Laplacian.
-  save_basis(dir_ / "b.sdbasis", h_, mesh_);
+// Rewrites a file of this version as an older one: that version number, without the solver
+// report (56 bytes after the 32-byte header) that version 3 added.
+void downgrade(const std::filesystem::path& path, uint32_t version) {
+  std::string bytes;
   {
-    std::fstream file(dir_ / "b.sdbasis", std::ios::in | std::ios::out | std::ios::binary);
-    const uint32_t version = 1;
-    file.seekp(8);
-    file.write(reinterpret_cast<const char*>(&version), sizeof version);
+    std::ifstream file(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(file), {});
   }
-  const ManifoldHarmonics back = load_basis(dir_ / "b.sdbasis", mesh_);
-  EXPECT_EQ(back.laplacian, LaplacianType::Cotan);
-  EXPECT_EQ(back.basis, h_.basis);
+  bytes.erase(32, 56);
+  std::memcpy(bytes.data() + 8, &version, sizeof version);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+TEST_F(BasisCache, ReadsVersionsOneAndTwo) {
+  // Version 1 had a reserved zero where version 2 keeps the Laplacian; neither has the report.
+  for (const uint32_t version : {1u, 2u}) {
+    save_basis(dir_ / "b.sdbasis", h_, mesh_);
+    downgrade(dir_ / "b.sdbasis", version);
+    const ManifoldHarmonics back = load_basis(dir_ / "b.sdbasis", mesh_);
+    EXPECT_EQ(back.laplacian, LaplacianType::Cotan);
+    EXPECT_EQ(back.basis, h_.basis);
+    EXPECT_TRUE(std::isnan(back.max_residual)) << "not recorded: unknown, not 0";
+  }
   {
     std::fstream file(dir_ / "b.sdbasis", std::ios::in | std::ios::out | std::ios::binary);
-    const uint32_t version = 3;
+    const uint32_t version = 4;
     file.seekp(8);
     file.write(reinterpret_cast<const char*>(&version), sizeof version);
   }
   EXPECT_THROW(load_basis(dir_ / "b.sdbasis", mesh_), InputError);
+}
+
+// The solver's report comes back with the basis (the editor shows it for a cached basis).
+TEST_F(BasisCache, KeepsTheSolverReport) {
+  save_basis(dir_ / "b.sdbasis", h_, mesh_);
+  const ManifoldHarmonics back = load_basis(dir_ / "b.sdbasis", mesh_);
+  EXPECT_GT(h_.max_residual, 0.0);
+  EXPECT_EQ(back.max_residual, h_.max_residual);
+  EXPECT_EQ(back.rounding_floor, h_.rounding_floor);
+  EXPECT_EQ(back.threshold, h_.threshold);
+  EXPECT_EQ(back.max_orthogonality_error, h_.max_orthogonality_error);
+  EXPECT_EQ(back.status, h_.status);
+  EXPECT_EQ(back.cluster_truncated, h_.cluster_truncated);
+  EXPECT_EQ(back.bands, h_.bands);
+  EXPECT_EQ(back.restarts, h_.restarts);
+  EXPECT_EQ(back.solves, h_.solves);
 }
 
 TEST_F(BasisCache, RefusesAnotherMeshOrABrokenFile) {

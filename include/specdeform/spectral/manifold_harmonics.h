@@ -45,6 +45,24 @@ enum class EigenSolver { BlockKrylov, Lanczos };
 // Called now and then during long computations: fraction done in [0, 1] and the stage's name.
 using ProgressCallback = std::function<void(double fraction, std::string_view stage)>;
 
+// The tuning constants of the solvers, measured on the armadillo (docs/results.md); unit-area
+// scale. Rarely changed; named here so that each is in one place.
+struct ManifoldHarmonicsPolicy {
+  int dense_limit = 1200;       // meshes of at most this many vertices: dense solver
+  int single_band_limit = 150;  // m up to this: one band, shift below the spectrum
+  int band_size = 90;           // larger m: bands of this many pairs at interior shifts
+  int wide_block_from = 72;     // bands of this many pairs or more: blocks of 8, else of 4
+  double shift_advance = 0.35;  // next shift: last eigenvalue found + this * band * spacing
+  double near_radius = 1.2;     // found pairs within this * band * spacing of a shift are
+                                // deflated from every block (the others at the end)
+  double krylov_margin = 0.1;   // the Krylov-Schur test asks this fraction of the tolerance, so
+                                // that the verified residuals meet the tolerance itself
+  double redo_factor = 10;      // an interior band this far above its thresholds is redone
+  double floor_factor = 100;    // a pair's threshold: max(tolerance, this * its rounding floor)
+
+  void validate() const;  // throws InputError
+};
+
 struct ManifoldHarmonicsOptions {
   int num_modes = 100;  // m, 1 <= m < n
   MassType mass = MassType::Lumped;
@@ -57,6 +75,9 @@ struct ManifoldHarmonicsOptions {
   int max_restarts = 60;      // restarts per band (BlockKrylov) or Lanczos iterations / 10
   uint64_t seed = 1;          // for the random start block
   ProgressCallback progress;  // optional
+  ManifoldHarmonicsPolicy policy;
+
+  void validate() const;  // throws InputError; num_modes is checked against the mesh later
 };
 
 enum class SolveStatus { Converged, NotConverged };
@@ -67,9 +88,12 @@ struct ManifoldHarmonics {
   MassType mass = MassType::Lumped;
   LaplacianType laplacian = LaplacianType::Cotan;  // H is orthonormal in this Laplacian's M
 
+  // Converged: every pair's residual is within its threshold, max(tolerance,
+  // floor_factor * its rounding floor); `threshold` is the largest threshold applied.
   SolveStatus status = SolveStatus::Converged;
   double max_residual = 0.0;             // max over pairs, as `tolerance` defines it
   double rounding_floor = 0.0;           // max over pairs of the rounding error of K h - l M h
+  double threshold = 0.0;                // max over pairs of the threshold applied
   double max_orthogonality_error = 0.0;  // max |H^T M H - I|
   bool cluster_truncated = false;        // lambda_m is (nearly) equal to lambda_{m+1}
   int bands = 0;                         // shifts used (= factorizations)
@@ -88,13 +112,14 @@ ManifoldHarmonics compute_manifold_harmonics(const Eigen::SparseMatrix<double>& 
 // The residual of the computed pairs on the unit-area scale (area A = sum of M's entries):
 //     max_i  A ||K h_i - lambda_i M h_i||_{D^-1} / max(A lambda_i, 1),
 // D the row sums of M (= M when lumped). This is the measure of `tolerance`. A pair counts as
-// converged within 100 times the tolerance or, on meshes whose nearly degenerate triangles make
-// the rounding error of forming K h itself larger (rounding_floor), within 100 times that.
+// converged when its residual is within the tolerance or, on meshes whose nearly degenerate
+// triangles make the rounding error of forming K h itself larger (rounding_floor), within
+// policy.floor_factor times that.
 double eigen_residual(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M,
                       const Eigen::MatrixXd& H, const Eigen::VectorXd& lambda);
 
-// "residual 3.2e-08 (tolerance 1e-10, rounding floor 1.1e-09)": for messages about a result.
-std::string residual_summary(const ManifoldHarmonics& h, double tolerance);
+// "residual 3.2e-08 (threshold 1e-08, rounding floor 1.1e-12)": for messages about a result.
+std::string residual_summary(const ManifoldHarmonics& h);
 
 // max |H^T M H - I|.
 double orthonormality_error(const Eigen::SparseMatrix<double>& M, const Eigen::MatrixXd& H);

@@ -1,0 +1,155 @@
+#include "linalg/krylov_schur.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+
+#include "specdeform/exceptions.h"
+
+namespace specdeform::detail {
+
+using Mat = Eigen::MatrixXd;
+using Vec = Eigen::VectorXd;
+using Sparse = Eigen::SparseMatrix<double>;
+
+namespace {
+
+// Replaces the first k columns of V by V[:, :k] Z (k x c), c <= k, in place, a block of rows at a
+// time, so that no second n x k buffer is needed.
+template <typename Matrix>
+void multiply_in_place(Matrix& V, Eigen::Index k, const Mat& Z) {
+  constexpr int kRows = 2048;
+  Mat chunk;
+  for (Eigen::Index r = 0; r < V.rows(); r += kRows) {
+    const Eigen::Index rows = std::min<Eigen::Index>(kRows, V.rows() - r);
+    chunk.noalias() = V.block(r, 0, rows, k) * Z;
+    V.block(r, 0, rows, Z.cols()) = chunk;
+  }
+}
+
+}  // namespace
+
+KrylovSchurResult krylov_schur(ShiftInvert& op, const MassOperator& M, const Basis& found,
+                               const Basis& near, const KrylovSchurSettings& set,
+                               std::mt19937_64& rng, const std::function<void(double)>& progress) {
+  const int n = static_cast<int>(M.matrix().rows());
+  const int b = set.block, s = set.subspace;
+  const int width = (b + 7) / 8 * 8;  // basis_sweep's blocks: a multiple of 8 columns
+  const double sigma = op.sigma();
+  RowMatrix V(n, s);
+  Mat T(0, 0), F(0, b);
+  int k = 0;
+  Mat start = random_block(n, b, rng);
+  orthonormalize(start, {found}, M, rng);
+  RowMatrix Q = start;
+  KrylovSchurResult out;
+  // Buffers kept from step to step: no page faults for large meshes. Row-major: the solver's
+  // permutation then moves whole rows.
+  RowMatrix X = RowMatrix::Zero(n, width), D1, D2, gram, MQ, solved;
+  Mat W;
+  int steps = 0, last_converged = 0;
+  double estimate = 2.0 * (s / b), done = 0.0;  // total block steps, fraction reported
+  for (;;) {
+    while (k + b <= s) {
+      done = std::max(done, std::min(0.99, steps++ / estimate));
+      progress(done);
+      V.middleCols(k, b) = Q;
+      M.apply(Q, MQ);
+      op.solve(MQ, solved);
+      out.solves += b;
+      // W = V C + Q' R: block classical Gram-Schmidt against V, twice, each pass's subtraction
+      // fused with the next one's projection; then Cholesky QR within the block.
+      X.leftCols(b) = solved;
+      M.project(V, k + b, X, nullptr, &D1, nullptr);
+      M.project(V, k + b, X, &D1, &D2, nullptr);
+      M.project(V, k + b, X, &D2, nullptr, near.cols() > 0 ? nullptr : &gram);
+      const Mat C = (D1 + D2).leftCols(b);
+      if (near.cols() > 0) {
+        W = X.leftCols(b);
+        project_out(W, {near}, M);
+        X.leftCols(b) = W;
+        gram = M.gram(W);
+      }
+      Mat R = Mat::Identity(b, b);
+      if (!cholesky_qr2(X.leftCols(b), M, R, gram.topLeftCorner(b, b))) {  // ill-conditioned
+        W = X.leftCols(b);
+        Mat Rg = Mat::Zero(b, b);
+        column_gram_schmidt(W, M, 1e-10, Rg, [&](int j) {
+          // invariant subspace found: continue with a fresh direction
+          Mat fresh = random_block(n, 1, rng);
+          orthonormalize(fresh, {found, Mat(V.leftCols(k + b)), W.leftCols(j)}, M, rng);
+          W.col(j) = fresh.col(0);
+        });
+        X.leftCols(b) = W;
+        R = Rg * R;
+      }
+      Q = X.leftCols(b);
+      Mat Tn = Mat::Zero(k + b, k + b);
+      Tn.topLeftCorner(k, k) = T;
+      Tn.bottomLeftCorner(b, k) = F.transpose();
+      Tn.rightCols(b) = C;
+      T = 0.5 * (Tn + Tn.transpose());
+      F = Mat::Zero(k + b, b);
+      F.bottomRows(b) = R.transpose();
+      k += b;
+    }
+    Eigen::SelfAdjointEigenSolver<Mat> eig(T);
+    std::vector<int> order(k);
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](int i, int j) {
+      return std::abs(eig.eigenvalues()[i]) > std::abs(eig.eigenvalues()[j]);
+    });
+    const int keep = std::min(s - b, std::max(set.wanted + b, (set.wanted + s) / 2));
+    Mat Z(k, keep);
+    Vec theta(keep);
+    for (int i = 0; i < keep; ++i) {
+      Z.col(i) = eig.eigenvectors().col(order[i]);
+      theta[i] = eig.eigenvalues()[order[i]];
+    }
+    const Mat FZ = F.transpose() * Z;  // b x keep: Ritz residuals in the basis Q
+    int converged = 0;
+    while (converged < keep) {
+      // The refined vector A y / theta has the residual ||r||_M / theta^2 (see eigen_residual).
+      const double t = theta[converged];
+      const double lambda = sigma + 1.0 / t;
+      if (!(FZ.col(converged).norm() <= set.tolerance * std::max(std::abs(lambda), 1.0) * t * t))
+        break;
+      ++converged;
+    }
+    const int gained = converged - last_converged;
+    last_converged = converged;
+    const double restarts_left =
+        gained > 0 ? double(set.wanted - converged) / gained : set.max_restarts - out.restarts;
+    estimate = steps + std::max(0.0, restarts_left) * ((s - keep) / b);
+    if (converged >= set.wanted || out.restarts >= set.max_restarts) {
+      out.converged = converged >= set.wanted;
+      const int count = std::max(converged, std::min(set.wanted, keep));
+      Mat G = V.leftCols(k) * Z.leftCols(count);
+      G.noalias() += Q * (FZ.leftCols(count) * theta.head(count).cwiseInverse().asDiagonal());
+      project_out(G, {found}, M);  // Rayleigh-Ritz makes G M-orthonormal
+      out.H = std::move(G);
+      out.lambda = (sigma + theta.head(count).cwiseInverse().array()).matrix();
+      return out;
+    }
+    ++out.restarts;  // thick restart with the `keep` best Ritz vectors
+    multiply_in_place(V, k, Z);
+    T = theta.asDiagonal();
+    F = FZ.transpose();
+    k = keep;
+  }
+}
+
+void rayleigh_ritz(const Sparse& K, const MassOperator& M, Mat& H, Vec& lambda) {
+  const Mat A = H.transpose() * (K * H);
+  const Mat B = M.gram(H);
+  Eigen::GeneralizedSelfAdjointEigenSolver<Mat> eig(0.5 * (A + A.transpose()),
+                                                    0.5 * (B + B.transpose()));
+  if (eig.info() != Eigen::Success) throw SolverError("Rayleigh-Ritz step failed");
+  multiply_in_place(H, H.cols(), eig.eigenvectors());
+  lambda = eig.eigenvalues();
+}
+
+}  // namespace specdeform::detail

@@ -1,0 +1,28 @@
+// Internal: the accuracy of computed eigenpairs of K h = lambda M h, per pair, on the unit-area
+// scale (A = sum of M's entries, D = M's row sums):
+//     residual = A ||K h - lambda M h||_{D^-1} / max(A lambda, 1),
+//     floor    = eps A || |K||h| + |lambda| |M||h| ||_{D^-1} / max(A lambda, 1),
+// the floor being the rounding error of forming K h - lambda M h itself: no solver gets below
+// it, and on meshes with nearly degenerate triangles (huge cotangent weights, tiny areas) it
+// exceeds any sensible tolerance. A pair meets a tolerance when its residual is at most
+// max(tolerance, floor_factor * floor): its threshold.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Sparse>
+
+namespace specdeform::detail {
+
+struct PairErrors {
+  Eigen::VectorXd residual, floor;
+
+  // Each pair's threshold, as above.
+  Eigen::VectorXd thresholds(double tolerance, double floor_factor) const;
+  // Whether every residual is within `factor` times its threshold.
+  bool within(double tolerance, double floor_factor, double factor = 1.0) const;
+};
+
+PairErrors pair_errors(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M,
+                       const Eigen::MatrixXd& H, const Eigen::VectorXd& lambda);
+
+}  // namespace specdeform::detail

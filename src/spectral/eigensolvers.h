@@ -1,0 +1,42 @@
+// Internal: the three ways compute_manifold_harmonics() solves K h = lambda M h for the first m
+// pairs, all on the unit-area scale (M of total mass 1), ascending, H^T M H = I:
+//  - solve_dense: Eigen's dense generalized solver (small meshes, or m close to n);
+//  - solve_lanczos: Spectra's shift-invert Lanczos on CHOLMOD, the plain baseline;
+//  - solve_block_krylov: K's null space (the constants of each connected component) exactly,
+//    then bands of pairs by shift-invert block Krylov-Schur (linalg/krylov_schur.h), the first
+//    below the spectrum, later ones at interior shifts, each deflated against the pairs found.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Sparse>
+
+#include "specdeform/spectral/manifold_harmonics.h"
+
+namespace specdeform::detail {
+
+struct Spectrum {
+  Eigen::VectorXd lambda;
+  Eigen::MatrixXd H;
+  SolveStatus status = SolveStatus::Converged;
+  int bands = 0, restarts = 0, analyses = 0;
+  long long solves = 0;
+  bool cluster_truncated = false;  // lambda_m (nearly) equals lambda_{m+1}
+};
+
+Spectrum solve_dense(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M,
+                     int m);
+Spectrum solve_lanczos(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M,
+                       const ManifoldHarmonicsOptions& options);
+Spectrum solve_block_krylov(const Eigen::SparseMatrix<double>& K,
+                            const Eigen::SparseMatrix<double>& M,
+                            const ManifoldHarmonicsOptions& options);
+
+// K's null space, known exactly: the constants on each connected component of K's graph,
+// M-normalised; n x (number of components).
+Eigen::MatrixXd stiffness_null_space(const Eigen::SparseMatrix<double>& K,
+                                     const Eigen::SparseMatrix<double>& M);
+
+// Reports progress through options.progress, if set.
+void report(const ManifoldHarmonicsOptions& options, double fraction, std::string_view stage);
+
+}  // namespace specdeform::detail
