@@ -36,6 +36,9 @@ void add_basis_command(CLI::App& app) {
       save_basis(args->output, h, loaded.mesh,
                  args->float32 ? BasisPrecision::Float32 : BasisPrecision::Float64);
     }
+    if (!converged) {
+      throw SolverError("manifold harmonics did not converge: " + residual_summary(h));
+    }
     if (args->json) {
       nlohmann::ordered_json j;
       j["vertices"] = loaded.mesh.num_vertices();
@@ -59,10 +62,7 @@ void add_basis_command(CLI::App& app) {
                 << ", orthonormality " << h.max_orthogonality_error << ")\n"
                 << "eigenvalues " << h.eigenvalues[0] << " ... "
                 << h.eigenvalues[h.eigenvalues.size() - 1] << "\n";
-      if (!args->output.empty() && converged) std::cout << "wrote " << args->output << "\n";
-    }
-    if (!converged) {
-      throw SolverError("manifold harmonics did not converge: " + residual_summary(h));
+      if (!args->output.empty()) std::cout << "wrote " << args->output << "\n";
     }
   });
 }

@@ -164,7 +164,7 @@ void add_harmonics_options(CLI::App& cmd, ManifoldHarmonicsOptions& o) {
   cmd.add_option("--eigensolver", o.solver,
                  "krylov (block Krylov-Schur, default) or lanczos (Spectra, the baseline)")
       ->transform(CLI::CheckedTransformer(kSolver, CLI::ignore_case));
-  cmd.add_option("--tolerance", o.tolerance, "eigenpair residual to reach (default 1e-10)")
+  cmd.add_option("--tolerance", o.tolerance, "eigenpair residual to reach (default 1e-8)")
       ->check(kPositive);
   cmd.add_option("--band-size", o.band_size, "eigenpairs per shift (default: automatic)")
       ->check(kNonNegative);

@@ -7,6 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "linalg/parallel.h"
 #include "specdeform/exceptions.h"
 
 namespace specdeform::detail {
@@ -18,16 +19,18 @@ using Sparse = Eigen::SparseMatrix<double>;
 namespace {
 
 // Replaces the first k columns of V by V[:, :k] Z (k x c), c <= k, in place, a block of rows at a
-// time, so that no second n x k buffer is needed.
+// time, so that no second n x k buffer is needed; the rows in two halves on two threads.
 template <typename Matrix>
 void multiply_in_place(Matrix& V, Eigen::Index k, const Mat& Z) {
   constexpr int kRows = 2048;
-  Mat chunk;
-  for (Eigen::Index r = 0; r < V.rows(); r += kRows) {
-    const Eigen::Index rows = std::min<Eigen::Index>(kRows, V.rows() - r);
-    chunk.noalias() = V.block(r, 0, rows, k) * Z;
-    V.block(r, 0, rows, Z.cols()) = chunk;
-  }
+  split_in_two(V.rows(), [&](Eigen::Index begin, Eigen::Index end) {
+    Mat chunk;
+    for (Eigen::Index r = begin; r < end; r += kRows) {
+      const Eigen::Index rows = std::min<Eigen::Index>(kRows, end - r);
+      chunk.noalias() = V.block(r, 0, rows, k) * Z;
+      V.block(r, 0, rows, Z.cols()) = chunk;
+    }
+  });
 }
 
 }  // namespace

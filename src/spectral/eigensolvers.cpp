@@ -12,6 +12,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
 
+#include "linalg/blas_threads.h"
 #include "linalg/krylov_schur.h"
 #include "specdeform/exceptions.h"
 #include "spectral/eigen_residual.h"
@@ -135,6 +136,7 @@ Spectrum solve_block_krylov(const Sparse& K, const Sparse& Mmat,
   const ManifoldHarmonicsPolicy& policy = o.policy;
   const MassOperator M(Mmat);
   ShiftInvertAnalysis analysis(K, Mmat);
+  const SingleThreadedBlas blas;  // the loops' two threads are ours
   std::mt19937_64 rng(o.seed);
   const int band =
       o.band_size > 0 ? o.band_size : (m <= policy.single_band_limit ? m : policy.band_size);

@@ -87,7 +87,8 @@ ManifoldHarmonics compute_manifold_harmonics(const Sparse& K, const Sparse& M,
   const Sparse M_unit = M / area;
 
   detail::Spectrum s;
-  const bool dense = n <= o.policy.dense_limit || 3 * m > 2 * n;
+  const int first_band = std::min(m, o.policy.single_band_limit) + 2;
+  const bool dense = n <= o.policy.dense_limit || 3 * m > 2 * n || 4 * first_band > n;
   if (dense) {
     if (n > 6000) {
       throw InputError("manifold harmonics: m = " + std::to_string(m) + " is too close to n = " +
