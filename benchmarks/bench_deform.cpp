@@ -1,6 +1,7 @@
 // One deformation frame and one selection change, spectral (m = 100, deformation transfer)
 // against the prefactored spatial solver of the same energy (one back-substitution per frame,
-// the honest competitor), measured in the same run.
+// the honest competitor), measured in the same run; the paper's linear energy, and the ARAP
+// frame beside it (spectral_arap: cold, from the rest pose, as every frame here).
 //
 // Scene: ../shared/meshes/models/armadillo.obj (43,243 vertices), handle = the vertices within
 // 5% of the bounding-box diagonal of the right hand (vertex 42163), fixed = the lowest 10% (the
@@ -57,8 +58,10 @@ const Setup& setup(int subdivisions) {
   return *s;
 }
 
-SpectralDeformer make(const Setup& s, DeformSolver solver, bool float32 = false) {
+SpectralDeformer make(const Setup& s, DeformSolver solver,
+                      DeformEnergy energy = DeformEnergy::Linear, bool float32 = false) {
   DeformOptions o;
+  o.energy = energy;
   o.solver = solver;
   o.float32_basis = float32;
   if (solver == DeformSolver::Spatial) {
@@ -75,9 +78,9 @@ double median(std::vector<double> v) {
 }
 
 // The stages' medians over the iterations, in milliseconds.
-void BM_Frame(benchmark::State& state, DeformSolver solver, bool float32) {
+void BM_Frame(benchmark::State& state, DeformSolver solver, DeformEnergy energy, bool float32) {
   const Setup& s = setup(static_cast<int>(state.range(0)));
-  SpectralDeformer d = make(s, solver, float32);
+  SpectralDeformer d = make(s, solver, energy, float32);
   d.set_selection(s.selection);
   std::vector<double> reduced, inverse, detail;
   for (auto _ : state) {
@@ -105,19 +108,25 @@ void BM_SelectionChange(benchmark::State& state, DeformSolver solver) {
   state.counters["n"] = s.mesh.num_vertices();
 }
 
-BENCHMARK_CAPTURE(BM_Frame, spectral, DeformSolver::Spectral, false)
+BENCHMARK_CAPTURE(BM_Frame, spectral, DeformSolver::Spectral, DeformEnergy::Linear, false)
     ->ArgName("subdiv")
     ->Arg(0)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_Frame, spectral_float32, DeformSolver::Spectral, true)
+BENCHMARK_CAPTURE(BM_Frame, spectral_arap, DeformSolver::Spectral, DeformEnergy::Arap, false)
     ->ArgName("subdiv")
     ->Arg(0)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_Frame, spatial_prefactored, DeformSolver::Spatial, false)
+BENCHMARK_CAPTURE(BM_Frame, spectral_float32, DeformSolver::Spectral, DeformEnergy::Linear, true)
+    ->ArgName("subdiv")
+    ->Arg(0)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Frame, spatial_prefactored, DeformSolver::Spatial, DeformEnergy::Linear, false)
     ->ArgName("subdiv")
     ->Arg(0)
     ->Arg(2)

@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Regenerates docs/results/: the paper's Table 1, Fig. 5 and Fig. 6 measured on this machine,
-# pictures of the pipeline (original, smooth base, deformed base, detailed result), and the
-# intrinsic Delaunay Laplacian against the cotan one on every shared model.
+# pictures of the pipeline (original, smooth base, deformed base, detailed result), all with the
+# paper's linear energy; the linear energy, spectral ARAP and CGAL's SR-ARAP on scenes that turn
+# (tables and pictures); and the intrinsic Delaunay Laplacian against the cotan one on every
+# shared model.
 # Needs ../shared/meshes (the test meshes) and a build (scripts/setup.sh); installs
 # python3-matplotlib for the plot and chromium for the pictures where missing.
-# Usage: scripts/reproduce.sh [OUT]     (default: docs/results; takes about 25 minutes)
+# Usage: scripts/reproduce.sh [OUT]     (default: docs/results; takes about 30 minutes)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-docs/results}
@@ -25,20 +27,22 @@ echo "== machine"
   | tee "$out/machine.txt"
 
 echo "== Table 1"
-$bin bench "$models/lion.off" "$models/stanford-bunny.obj" "$arm" \
+$bin bench "$models/lion.off" "$models/stanford-bunny.obj" "$arm" --energy linear \
   --json "$out/table1.json" --markdown "$out/table1.md"
-$bin bench "$arm" --subdivide 1 2 --json "$out/table1_subdivided.json" \
+$bin bench "$arm" --subdivide 1 2 --energy linear --json "$out/table1_subdivided.json" \
   --markdown "$out/table1_subdivided.md"
 
 echo "== Fig. 5: time against m"
-$bin bench "$arm" -m 50 100 200 300 500 1000 --json "$out/fig5.json" --markdown "$out/fig5.md"
+$bin bench "$arm" -m 50 100 200 300 500 1000 --energy linear --json "$out/fig5.json" \
+  --markdown "$out/fig5.md"
 /usr/bin/python3 scripts/plot_fig5.py "$out/fig5.json" "$out/fig5.svg"
 
 echo "== Fig. 6: results against m"
-$bin converge "$arm" --scene "$hand" -m 50 100 200 300 500 900 -o "$work/fig6" \
-  --json "$out/fig6.json" --markdown "$out/fig6.md"
+$bin converge "$arm" --scene "$hand" --energy linear -m 50 100 200 300 500 900 \
+  -o "$work/fig6" --json "$out/fig6.json" --markdown "$out/fig6.md"
 $bin converge "$scenes/bar-bend.off" --sel "$scenes/bar-bend.sel" --def "$scenes/bar-bend.def" \
-  -m 50 100 200 300 500 900 --json "$out/fig6_bar_bend.json" --markdown "$out/fig6_bar_bend.md"
+  --energy linear -m 50 100 200 300 500 900 --json "$out/fig6_bar_bend.json" \
+  --markdown "$out/fig6_bar_bend.md"
 
 echo "== the pipeline (paper Fig. 1)"
 pipeline() {  # pipeline NAME MESH SCENE-ARGS...
@@ -46,11 +50,40 @@ pipeline() {  # pipeline NAME MESH SCENE-ARGS...
   shift 2
   cp "$mesh" "$work/${name}_1_original.${mesh##*.}"
   $bin smooth "$mesh" -m 100 -o "$work/${name}_2_smooth.obj"
-  $bin deform "$mesh" "$@" -m 100 --detail none -o "$work/${name}_3_deformed_base.obj"
-  $bin deform "$mesh" "$@" -m 100 --detail transfer -o "$work/${name}_4_deformed.obj"
+  $bin deform "$mesh" "$@" -m 100 --energy linear --detail none \
+    -o "$work/${name}_3_deformed_base.obj"
+  $bin deform "$mesh" "$@" -m 100 --energy linear --detail transfer \
+    -o "$work/${name}_4_deformed.obj"
 }
 pipeline armadillo "$arm" --scene "$hand"
 pipeline bar_bend "$scenes/bar-bend.off" --sel "$scenes/bar-bend.sel" --def "$scenes/bar-bend.def"
+
+echo "== Rotations: linear, spectral ARAP and SR-ARAP"
+for shape in bumpy-bar bumpy-tube; do
+  docs/results/scenes/bumpy_bar.py $shape "$work/$shape.off" "$bin"
+done
+rotations() {  # rotations NAME MESH SCENE-ARGS...
+  local name=$1 mesh=$2
+  shift 2
+  $bin compare "$mesh" "$@" --repeat 21 -o "$work/rotations_$name" \
+    --json "$out/rotations_$name.json" --markdown "$out/rotations_$name.md"
+}
+for s in bar-twist bar-bend bumpy-plane; do
+  rotations "${s//-/_}" "$scenes/$s.off" --sel "$scenes/$s.sel" --def "$scenes/$s.def"
+done
+for s in bumpy-bar-twist bumpy-bar-bend bumpy-tube-twist bumpy-tube-bend; do
+  rotations "${s//-/_}" "$work/${s%-*}.off" --scene "docs/results/scenes/$s.json"
+done
+rotations armadillo_hand "$arm" --scene "$hand"
+scripts/rotations_table.py "$out/rotations.md" \
+  "bar-twist (135 degrees)=$out/rotations_bar_twist.json" \
+  "bar-bend (90 degrees)=$out/rotations_bar_bend.json" \
+  "bumpy-plane (lifted)=$out/rotations_bumpy_plane.json" \
+  "bumpy bar, twist 150 degrees=$out/rotations_bumpy_bar_twist.json" \
+  "bumpy bar, bend 100 degrees=$out/rotations_bumpy_bar_bend.json" \
+  "bumpy tube, twist 150 degrees=$out/rotations_bumpy_tube_twist.json" \
+  "bumpy tube, bend 100 degrees=$out/rotations_bumpy_tube_bend.json" \
+  "armadillo hand=$out/rotations_armadillo_hand.json"
 
 echo "== A robust Laplacian: each Laplacian's eigenvalues against a finer remeshing"
 for mass in lumped consistent; do
@@ -69,6 +102,20 @@ done
 for f in "$work"/bar_bend_*; do
   base=$(basename "$f"); base=${base%.*}
   jobs+="{\"mesh\": \"$f\", \"png\": \"$out/pictures/$base.png\", \"view\": [0.2, 0.5, 1]},"
+done
+# The editor keeps its camera for another pose of the same mesh: each scene's three pictures share
+# the view fitted to its first, and consecutive scenes are on different meshes.
+for name in bumpy_bar_bend bar_bend bumpy_tube_bend bumpy_bar_twist bar_twist bumpy_tube_twist \
+  bumpy_plane armadillo_hand; do
+  case $name in
+    armadillo*) view="[0, 0.15, 1]" ;;
+    *plane) view="[0.2, -1, 0.45]" ;;
+    *) view="[0.2, 0.5, 1]" ;;
+  esac
+  for m in linear:linear__spectral arap:ARAP__spectral sr_arap:SR_ARAP__CGAL___converged; do
+    mesh=$work/rotations_$name/${m#*:}.obj png=$out/pictures/rotations_${name}_${m%%:*}.png
+    jobs+="{\"mesh\": \"$mesh\", \"png\": \"$png\", \"view\": $view},"
+  done
 done
 echo "${jobs%,}]" >"$work/jobs.json"
 node web/e2e/render.mjs "$work/jobs.json"

@@ -113,6 +113,11 @@ grep -q '^| bumpy-bar-6 ' "$tmp/bench.md" || { echo "FAIL: bench markdown lacks 
 expect 0 "$bin" converge "$tmp/p.off" --scene "$tmp/scene.json" -m 10 20 40 --json "$tmp/conv.json" -o "$tmp/conv"
 grep -q '"displacement_vs_spatial"' "$tmp/conv.json" && [ -s "$tmp/conv/m40_deformed.obj" ] ||
   { echo "FAIL: converge wrote no table or meshes"; fails=$((fails + 1)); }
+expect 0 "$bin" compare "$tmp/p.off" --scene "$tmp/scene.json" -m 20 --repeat 1 --peer-iterations 50 \
+  --json "$tmp/cmp.json" --markdown "$tmp/cmp.md" -o "$tmp/cmp"
+[ "$(grep -c '^| ' "$tmp/cmp.md")" = 6 ] && grep -q '"base_handle_miss"' "$tmp/cmp.json" &&
+  [ -s "$tmp/cmp/SR_ARAP__CGAL___converged.obj" ] ||
+  { echo "FAIL: compare wrote no table of five methods or no meshes"; fails=$((fails + 1)); }
 expect 0 "$bin" demo -o "$tmp/demo" -m 40
 [ -s "$tmp/demo/4_deformed.obj" ] || { echo "FAIL: demo wrote no deformed mesh"; fails=$((fails + 1)); }
 expect 1 "$bin" edit "$tmp/missing.obj" --port 0
