@@ -15,6 +15,7 @@
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/vertex_clusters.h"
 #include "specdeform/operators/cotan_laplacian.h"
+#include "specdeform/operators/laplacian.h"
 #include "specdeform/operators/mass_matrix.h"
 
 namespace specdeform {
@@ -222,8 +223,19 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
   }
   const VertexClusters clusters = vertex_clusters(TriangleMesh{base, mesh.F}, options.clusters);
   label_ = clusters.label;
-  const Sparse K = cotan_stiffness(mesh), membrane = detail::membrane_stiffness(K);
-  const Eigen::VectorXd mass = lumped_mass(mesh);
+  // The basis's own Laplacian and lumped mass, so that the reduced Hessian's H^T K H and
+  // H^T K M^-1 K H are its eigenvalues and their squares.
+  Sparse K;
+  Eigen::VectorXd mass;
+  if (basis) {
+    LaplacianOperators L = laplacian_operators(mesh, MassType::Lumped, basis->laplacian);
+    K = std::move(L.stiffness);
+    mass = L.mass.diagonal();
+  } else {
+    K = cotan_stiffness(mesh);
+    mass = lumped_mass(mesh);
+  }
+  const Sparse membrane = detail::membrane_stiffness(K);
   // Membrane and bending, as the linear energy's ks = 1 and kb = bending (unit-area scale).
   const Sparse A = cluster_operator(membrane, base, label_, clusters.count) +
                    (2.0 * options.bending * mass.sum()) *

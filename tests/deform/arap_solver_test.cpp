@@ -4,12 +4,14 @@
 
 #include <algorithm>
 #include <numbers>
+#include <random>
 
 #include "specdeform/deform/deformation_quality.h"
 #include "specdeform/deform/scene.h"
 #include "specdeform/deform/spectral_deformer.h"
 #include "specdeform/mesh/generate.h"
 #include "specdeform/mesh/io.h"
+#include "specdeform/operators/cotan_laplacian.h"
 #include "support/corpus.h"
 
 namespace specdeform {
@@ -135,6 +137,49 @@ TEST(ArapSolver, ZeroDeformationReturnsTheInput) {
       EXPECT_LT(point_distances(out, expected).max, 1e-9 * diagonal)
           << static_cast<int>(solver) << " " << static_cast<int>(method);
     }
+  }
+}
+
+// With a basis of the intrinsic Delaunay Laplacian the energy is built from that Laplacian: its
+// weights are non-negative, so no correction for dropped negative weights (there is one with the
+// cotan basis of the same skewed mesh), and the rest shape and rigid motions are reproduced.
+TEST(ArapSolver, UsesTheBasissLaplacian) {
+  Bar bar = tube(6, 16);
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> jitter(-0.07, 0.07);
+  for (int i = 0; i < bar.mesh.num_vertices(); ++i) bar.mesh.V(i, 0) += jitter(rng);
+  const Eigen::SparseMatrix<double> K = cotan_stiffness(bar.mesh);
+  int negative = 0;  // positive off-diagonal entries of K
+  for (int j = 0; j < K.outerSize(); ++j)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(K, j); it; ++it)
+      negative += it.row() != j && it.value() > 0.0;
+  ASSERT_GT(negative, 0) << "the skewed tube has negative cotangent weights";
+  const double diagonal = bounding_box_diagonal(bar.mesh.V);
+  for (const LaplacianType type : {LaplacianType::Cotan, LaplacianType::IntrinsicDelaunay}) {
+    ManifoldHarmonicsOptions ho;
+    ho.num_modes = 40;
+    ho.laplacian = type;
+    const auto h = std::make_shared<ManifoldHarmonics>(compute_manifold_harmonics(bar.mesh, ho));
+    const ArapSolver solver(bar.mesh, bar.mesh.V, h, ArapOptions{});
+    const double correction = solver.membrane_correction().cwiseAbs().maxCoeff();
+    if (type == LaplacianType::Cotan) {
+      EXPECT_GT(correction, 1e-6 * h->eigenvalues.maxCoeff());
+    } else {
+      EXPECT_LE(correction, 1e-9 * h->eigenvalues.maxCoeff());
+    }
+    SpectralDeformer deformer(bar.mesh, h, arap(1e-10, 500));
+    deformer.set_selection(bar.selection);
+    EXPECT_LT(point_distances(deformer.solve({Eigen::Affine3d::Identity()}), bar.mesh.V).max,
+              1e-9 * diagonal);
+    const Eigen::Affine3d motion(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY()));
+    Selection both_ends;
+    both_ends.handles = {bar.selection.fixed};
+    both_ends.handles[0].insert(both_ends.handles[0].end(), bar.selection.handles[0].begin(),
+                                bar.selection.handles[0].end());
+    deformer.set_selection(both_ends);
+    const Vertices expected = (motion * bar.mesh.V.transpose()).transpose();
+    EXPECT_LT(point_distances(deformer.solve({motion}), expected).max, 1e-6 * diagonal)
+        << name(type);
   }
 }
 

@@ -8,7 +8,8 @@
 //     E(d, R) = 1/2 sum_i sum_{j ~ i} w+_ij |(s'_i - s'_j) - R_k(i) (s_i - s_j)|^2      membrane
 //             + b A sum_i a_i |(M^-1 K s')_i - R_k(i) (M^-1 K s)_i|^2                    bending
 //             + constraints,
-// K the detailed mesh's cotangent stiffness matrix, M its lumped mass (a_i), A its area,
+// K the detailed mesh's stiffness matrix (the basis's Laplacian, cotan or intrinsic Delaunay;
+// cotan without a basis), M that Laplacian's lumped mass (a_i), A the area,
 // w+_ij = max(w_ij, 0) (negative weights would make a cluster's rest covariance indefinite and
 // the rest pose no minimum), b = ArapOptions::bending. The membrane term keeps edge vectors, the
 // bending term mean-curvature normals, each turned by its cluster's rotation; with every
@@ -69,7 +70,7 @@ struct ArapState {
 
 class ArapSolver {
  public:
-  // mesh: the detailed mesh (its cotangent weights); base: its smooth base s (n x 3); basis:
+  // mesh: the detailed mesh (its Laplacian's weights); base: its smooth base s (n x 3); basis:
   // the manifold harmonics (the spectral subspace) or null (all vertices).
   ArapSolver(const TriangleMesh& mesh, const Vertices& base,
              std::shared_ptr<const ManifoldHarmonics> basis, const ArapOptions& options);
