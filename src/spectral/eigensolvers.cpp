@@ -79,6 +79,10 @@ Spectrum solve_dense(const Sparse& K, const Sparse& M, int m) {
   Eigen::GeneralizedSelfAdjointEigenSolver<Mat> eig{Mat(K), Mat(M)};
   if (eig.info() != Eigen::Success) throw SolverError("dense generalized eigensolver failed");
   Spectrum out{eig.eigenvalues().head(m), eig.eigenvectors().leftCols(m)};
+  // K's null space (one constant per connected component) has the eigenvalue 0 exactly, not
+  // the solver's +-1e-16.
+  const Eigen::Index zeros = std::min<Eigen::Index>(m, stiffness_null_space(K, M).cols());
+  out.lambda.head(zeros).setZero();
   out.bands = 1;
   out.cluster_truncated = m < K.rows() && same_eigenvalue(out.lambda[m - 1], eig.eigenvalues()[m]);
   return out;
