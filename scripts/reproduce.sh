@@ -91,6 +91,10 @@ for mass in lumped consistent; do
     --markdown "$out/laplacian_$mass.md"
 done
 
+echo "== The basis against scipy's eigsh (same run, medians of 5)"
+PYTHONPATH=build/python /usr/bin/python3 benchmarks/basis_vs_scipy.py "$arm" -k 100 --repeat 5 \
+  --json "$out/basis_vs_scipy.json"
+
 echo "== pictures"
 jobs="["
 for f in "$work"/armadillo_* "$work"/fig6/m*_deformed.obj; do
