@@ -109,7 +109,8 @@ void add_compare_command(CLI::App& app) {
       // The spatial solve deforms the detailed mesh itself (eq. 14), the others its base.
       SpectralDeformer deformer(mesh, o.solver == DeformSolver::Spectral ? basis : nullptr, o);
       deformer.set_selection(loaded.selection);
-      Method m{name};
+      Method m;
+      m.name = name;
       m.frame_ms = 1e3 * median_frame(deformer, transforms, args->repeat, &m.result).total;
       m.setup_ms = 1e3 * (deformer.setup_timings().reduced_system +
                           deformer.setup_timings().detail_factorization);
@@ -161,7 +162,8 @@ void add_compare_command(CLI::App& app) {
     // Converged: chunks of iterations until one moves no vertex by more than 1e-5 of the
     // diagonal (or the caps).
     peer.reset();
-    Method converged{"SR-ARAP (CGAL), converged"};
+    Method converged;
+    converged.name = "SR-ARAP (CGAL), converged";
     converged.setup_ms = 1e3 * peer.setup_seconds();
     converged.converged = false;
     const Stopwatch clock;

@@ -21,7 +21,7 @@ std::vector<int> cells_of(const Vertices& V, const Eigen::RowVector3d& lo, doubl
   for (Eigen::Index v = 0; v < V.rows(); ++v) {
     uint64_t key = 0;
     for (int k = 0; k < 3; ++k) {
-      key = key << 21 | static_cast<uint64_t>(std::floor((V(v, k) - lo[k]) / size)) & 0x1fffff;
+      key = key << 21 | (static_cast<uint64_t>(std::floor((V(v, k) - lo[k]) / size)) & 0x1fffff);
     }
     cell[v] = index.try_emplace(key, static_cast<int>(index.size())).first->second;
   }
