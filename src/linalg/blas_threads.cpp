@@ -18,14 +18,14 @@ Function lookup(const char* name) {
 
 SingleThreadedBlas::SingleThreadedBlas() {
   const auto get = lookup<GetThreads>("openblas_get_num_threads");
-  const auto set = lookup<SetThreads>("openblas_set_num_threads");
-  if (get == nullptr || set == nullptr) return;
+  set_ = lookup<SetThreads>("openblas_set_num_threads");
+  if (get == nullptr || set_ == nullptr) return;
   previous_ = get();
-  if (previous_ > 1) set(1);
+  if (previous_ > 1) set_(1);
 }
 
 SingleThreadedBlas::~SingleThreadedBlas() {
-  if (previous_ > 1) lookup<SetThreads>("openblas_set_num_threads")(previous_);
+  if (previous_ > 1) set_(previous_);
 }
 
 }  // namespace specdeform::detail

@@ -16,7 +16,8 @@ class SingleThreadedBlas {
   SingleThreadedBlas& operator=(const SingleThreadedBlas&) = delete;
 
  private:
-  int previous_ = 0;  // 0: nothing to restore
+  void (*set_)(int) = nullptr;  // openblas_set_num_threads, where there is one
+  int previous_ = 0;
 };
 
 }  // namespace specdeform::detail

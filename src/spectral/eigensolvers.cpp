@@ -229,7 +229,6 @@ Spectrum solve_block_krylov(const Sparse& K, const Sparse& Mmat,
     // The next band's window (radius about band/2 spacings) reaches below the last pair found.
     sigma = out.lambda[count - 1] + policy.shift_advance * band * std::max(spacing, 1e-6);
   }
-  out.analyses = analysis.analyses();
   return out;
 }
 

@@ -18,7 +18,7 @@ struct Spectrum {
   Eigen::VectorXd lambda;
   Eigen::MatrixXd H;
   SolveStatus status = SolveStatus::Converged;
-  int bands = 0, restarts = 0, analyses = 0;
+  int bands = 0, restarts = 0;
   long long solves = 0;
   bool cluster_truncated = false;  // lambda_m (nearly) equals lambda_{m+1}
 };

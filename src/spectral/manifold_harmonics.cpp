@@ -127,7 +127,6 @@ ManifoldHarmonics compute_manifold_harmonics(const Sparse& K, const Sparse& M,
 
 ManifoldHarmonics compute_manifold_harmonics(const TriangleMesh& mesh,
                                              const ManifoldHarmonicsOptions& options) {
-  options.validate();
   const LaplacianOperators L = laplacian_operators(mesh, options.mass, options.laplacian);
   ManifoldHarmonics h = compute_manifold_harmonics(L.stiffness, L.mass, options);
   h.mass = options.mass;

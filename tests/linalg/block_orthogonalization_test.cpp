@@ -19,6 +19,13 @@ Sparse mass(int n) {
   return M;
 }
 
+// rows x cols, M-orthonormal.
+Mat orthonormal_block(int rows, int cols, const MassOperator& M, std::mt19937_64& rng) {
+  Mat B = detail::random_block(rows, cols, rng);
+  detail::orthonormalize(B, {}, M, rng);
+  return B;
+}
+
 double orthonormality(const Mat& W, const Sparse& M) {
   return (W.transpose() * M * W - Mat::Identity(W.cols(), W.cols())).cwiseAbs().maxCoeff();
 }
@@ -73,8 +80,7 @@ TEST(BlockOrthogonalization, ProjectsOutBases) {
   std::mt19937_64 rng(3);
   const Sparse Ms = mass(300);
   const MassOperator M(Ms);
-  Mat B = detail::random_block(300, 30, rng);
-  detail::orthonormalize(B, {}, M, rng);
+  const Mat B = orthonormal_block(300, 30, M, rng);
   Mat W = detail::random_block(300, 8, rng);
   W.col(0) = B.col(4) + 1e-9 * W.col(0);  // almost in the basis: cancellation, a second pass
   detail::project_out(W, {B.leftCols(10), B.rightCols(20)}, M);
@@ -89,8 +95,7 @@ TEST(BlockOrthogonalization, RefusesABlockLargerThanTheSpace) {
   std::mt19937_64 rng(4);
   const Sparse Ms = mass(10);
   const MassOperator M(Ms);
-  Mat B = detail::random_block(10, 8, rng);
-  detail::orthonormalize(B, {}, M, rng);
+  const Mat B = orthonormal_block(10, 8, M, rng);
   Mat W = detail::random_block(10, 4, rng);
   EXPECT_THROW(detail::orthonormalize(W, {B}, M, rng), SolverError);
 }

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <random>
 #include <vector>
 
@@ -37,24 +38,31 @@ struct DiagonalProblem {
   }
 };
 
+// The `wanted` pairs nearest the shift -0.5, blocks of 4, deflated against `found` (given as
+// near too); Rayleigh-Ritz applied, so that the pairs come out ascending.
+detail::KrylovSchurResult nearest_pairs(const DiagonalProblem& p, const Mat& found, int wanted,
+                                        int subspace, uint64_t seed) {
+  const MassOperator M(p.M);
+  detail::ShiftInvertAnalysis analysis(p.K, p.M);
+  std::mt19937_64 rng(seed);
+  detail::ShiftInvert op(analysis, -0.5, rng);
+  EXPECT_TRUE(op.usable());
+  detail::KrylovSchurSettings set;
+  set.wanted = wanted;
+  set.block = 4;
+  set.subspace = subspace;
+  set.tolerance = 1e-10;
+  detail::KrylovSchurResult r = detail::krylov_schur(op, M, found, found, set, rng, [](double) {});
+  detail::rayleigh_ritz(p.K, M, r.H, r.lambda);
+  return r;
+}
+
 // The wanted pairs nearest the shift, the cluster complete, the vectors in the right coordinates.
 TEST(KrylovSchur, DiagonalOperatorWithAPlantedCluster) {
   const DiagonalProblem p(1500);
-  const MassOperator M(p.M);
-  detail::ShiftInvertAnalysis analysis(p.K, p.M);
-  std::mt19937_64 rng(1);
-  detail::ShiftInvert op(analysis, -0.5, rng);
-  ASSERT_TRUE(op.usable());
-  detail::KrylovSchurSettings set;
-  set.wanted = 20;
-  set.block = 4;
-  set.subspace = 48;
-  set.tolerance = 1e-10;
-  const Mat none(1500, 0);
-  detail::KrylovSchurResult r = detail::krylov_schur(op, M, none, none, set, rng, [](double) {});
+  const detail::KrylovSchurResult r = nearest_pairs(p, Mat(1500, 0), 20, 48, 1);
   ASSERT_TRUE(r.converged);
   EXPECT_GE(r.restarts, 1);  // 20 wanted in a subspace of 48: it had to restart
-  detail::rayleigh_ritz(p.K, M, r.H, r.lambda);
   ASSERT_GE(r.lambda.size(), 20);
   for (int i = 0; i < 20; ++i) EXPECT_NEAR(r.lambda[i], p.lambda[i], 1e-9 * p.lambda[i]) << i;
   // H^T M H = I, and the cluster's vectors lie in the span of e_8 ... e_10 (9.5's in e_11).
@@ -72,20 +80,10 @@ TEST(KrylovSchur, DiagonalOperatorWithAPlantedCluster) {
 // Deflation: with the first pairs given as found, the next ones come out, orthogonal to them.
 TEST(KrylovSchur, DeflatesThePairsFound) {
   const DiagonalProblem p(800);
-  const MassOperator M(p.M);
-  detail::ShiftInvertAnalysis analysis(p.K, p.M);
-  std::mt19937_64 rng(2);
-  detail::ShiftInvert op(analysis, -0.5, rng);
   Mat found = Mat::Zero(800, 5);
   for (int i = 0; i < 5; ++i) found(i, i) = 1.0 / std::sqrt(p.mass[i]);
-  detail::KrylovSchurSettings set;
-  set.wanted = 10;
-  set.block = 4;
-  set.subspace = 32;
-  set.tolerance = 1e-10;
-  detail::KrylovSchurResult r = detail::krylov_schur(op, M, found, found, set, rng, [](double) {});
+  const detail::KrylovSchurResult r = nearest_pairs(p, found, 10, 32, 2);
   ASSERT_TRUE(r.converged);
-  detail::rayleigh_ritz(p.K, M, r.H, r.lambda);
   for (int i = 0; i < 10; ++i) EXPECT_NEAR(r.lambda[i], p.lambda[5 + i], 1e-9 * p.lambda[5 + i]);
   EXPECT_LE((found.transpose() * p.M * r.H).cwiseAbs().maxCoeff(), 1e-12);
 }
