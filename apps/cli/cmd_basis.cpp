@@ -46,6 +46,8 @@ void add_basis_command(CLI::App& app) {
       j["laplacian"] = name(h.laplacian);
       j["seconds"] = seconds;
       j["converged"] = converged;
+      j["approximate"] = h.approximate;
+      if (h.approximate) j["coarse_functions"] = h.coarse_functions;
       j["max_residual"] = h.max_residual;
       j["threshold"] = h.threshold;
       j["rounding_floor"] = h.rounding_floor;
@@ -55,11 +57,13 @@ void add_basis_command(CLI::App& app) {
       j["restarts"] = h.restarts;
       j["solves"] = h.solves;
       j["eigenvalues"] = std::vector<double>(h.eigenvalues.begin(), h.eigenvalues.end());
+      j["residuals"] = std::vector<double>(h.residuals.begin(), h.residuals.end());
       std::cout << j.dump() << "\n";
     } else {
-      std::cout << h.eigenvalues.size() << " eigenpairs of " << loaded.mesh.num_vertices()
-                << " vertices in " << seconds << " s (residual " << h.max_residual
-                << ", orthonormality " << h.max_orthogonality_error << ")\n"
+      std::cout << h.eigenvalues.size()
+                << (h.approximate ? " approximate (multilevel) eigenpairs of " : " eigenpairs of ")
+                << loaded.mesh.num_vertices() << " vertices in " << seconds << " s (residual "
+                << h.max_residual << ", orthonormality " << h.max_orthogonality_error << ")\n"
                 << "eigenvalues " << h.eigenvalues[0] << " ... "
                 << h.eigenvalues[h.eigenvalues.size() - 1] << "\n";
       if (!args->output.empty()) std::cout << "wrote " << args->output << "\n";

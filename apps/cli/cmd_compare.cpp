@@ -99,8 +99,7 @@ void add_compare_command(CLI::App& app) {
     ManifoldHarmonicsOptions h = args->harmonics;
     h.num_modes =
         loaded.scene.modes && cmd->count("--modes") == 0 ? *loaded.scene.modes : args->modes;
-    const auto basis =
-        std::make_shared<const ManifoldHarmonics>(obtain_basis(mesh, h, args->basis));
+    const auto basis = obtain_basis(mesh, h, args->basis);
     const double diagonal = bounding_box_diagonal(mesh.V);
 
     std::vector<Method> methods;

@@ -65,7 +65,8 @@ void add_converge_command(CLI::App& app) {
     modes.erase(std::unique(modes.begin(), modes.end()), modes.end());
     ManifoldHarmonicsOptions h = args->harmonics;
     h.num_modes = modes.back();
-    const ManifoldHarmonics full = obtain_basis(mesh, h, "");
+    const auto full_basis = obtain_basis(mesh, h, "");
+    const ManifoldHarmonics& full = *full_basis;
     const double diagonal = bounding_box_diagonal(mesh.V);
 
     // The spatial solution of the same energy and constraints (the smooth displacement's limit).

@@ -54,7 +54,7 @@ void add_deform_command(CLI::App& app) {
         constrained_set(selection, loaded.mesh, options.unconstrained, loaded.info.vertex_to_file);
 
     nlohmann::ordered_json timings;
-    ManifoldHarmonics basis;
+    std::shared_ptr<const ManifoldHarmonics> basis;
     bool loaded_basis = false;
     if (options.solver == DeformSolver::Spectral) {
       ManifoldHarmonicsOptions h = args->harmonics;
@@ -86,6 +86,7 @@ void add_deform_command(CLI::App& app) {
       j["vertices"] = loaded.mesh.num_vertices();
       j["modes"] = options.solver == DeformSolver::Spectral ? modes : 0;
       j["basis_cached"] = loaded_basis;
+      j["basis_approximate"] = deformer.basis() && deformer.basis()->approximate;
       j["constrained_vertices"] = constrained.first_held;
       j["held_pieces"] = constrained.held_pieces;
       j["energy"] = name(options.energy);

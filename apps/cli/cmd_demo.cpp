@@ -32,7 +32,8 @@ void add_demo_command(CLI::App& app) {
     ManifoldHarmonicsOptions o;
     o.num_modes = args->modes;
     const Stopwatch clock;
-    ManifoldHarmonics h = obtain_basis(bar, o, "");
+    const auto basis = obtain_basis(bar, o, "");
+    const ManifoldHarmonics& h = *basis;
     std::cout << "basis: " << h.eigenvalues.size() << " manifold harmonics in " << clock.seconds()
               << " s (residual " << h.max_residual << ", orthonormality "
               << h.max_orthogonality_error << ")\n";
@@ -48,7 +49,7 @@ void add_demo_command(CLI::App& app) {
     const Eigen::Affine3d bend = Eigen::Translation3d(2.0, 1.6, 0.0) *
                                  Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitZ()) *
                                  Eigen::Translation3d(-3.6, 0.0, 0.0);
-    SpectralDeformer deformer(bar, std::move(h));
+    SpectralDeformer deformer(bar, basis);
     deformer.set_selection(selection);
     const Vertices result = deformer.solve({bend});
     const FrameTimings& t = deformer.frame_timings();

@@ -41,6 +41,7 @@ void add_edit_command(CLI::App& app) {
   cmd->add_option("-m,--modes", args->editor.modes, "manifold harmonics used (default 100)")
       ->check(CLI::Range(1, 5000));
   args->deform.add_to(*cmd);
+  add_eigensolver_option(*cmd, args->editor.eigensolver);
   cmd->add_option("--cache-dir", args->editor.cache_dir,
                   "where bases are cached (default ~/.cache/specdeform)");
   cmd->add_flag("--no-cache", args->no_cache, "neither read nor write cached bases");

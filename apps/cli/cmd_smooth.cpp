@@ -24,7 +24,8 @@ void add_smooth_command(CLI::App& app) {
   add_harmonics_options(*cmd, args->options);
   cmd->callback([args] {
     const LoadedMesh loaded = load_mesh(args->mesh);
-    const ManifoldHarmonics h = obtain_basis(loaded.mesh, args->options, args->basis);
+    const auto basis = obtain_basis(loaded.mesh, args->options, args->basis);
+    const ManifoldHarmonics& h = *basis;
     const auto M = mass_matrix(loaded.mesh, h.mass, h.laplacian);
     const Eigen::MatrixXd smooth =
         harmonics_inverse(h.basis, harmonics_forward(h.basis, M, loaded.mesh.V));

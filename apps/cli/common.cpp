@@ -13,6 +13,7 @@
 #include "specdeform/atomic_file.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/spectral/basis_cache.h"
+#include "specdeform/spectral/basis_store.h"
 
 namespace specdeform::cli {
 
@@ -149,11 +150,18 @@ ProgressCallback progress_bar(const std::string& label) {
   };
 }
 
+void add_eigensolver_option(CLI::App& cmd, EigenSolver& solver) {
+  static const auto kSolver =
+      by_name({EigenSolver::BlockKrylov, EigenSolver::Lanczos, EigenSolver::Multilevel});
+  cmd.add_option("--eigensolver", solver,
+                 "krylov (block Krylov-Schur, exact, default), lanczos (Spectra, the baseline) or "
+                 "multilevel (an approximate basis, linear in n, for large meshes)")
+      ->transform(CLI::CheckedTransformer(kSolver, CLI::ignore_case));
+}
+
 void add_harmonics_options(CLI::App& cmd, ManifoldHarmonicsOptions& o) {
   static const std::map<std::string, MassType> kMass{{"lumped", MassType::Lumped},
                                                      {"consistent", MassType::Consistent}};
-  static const std::map<std::string, EigenSolver> kSolver{{"krylov", EigenSolver::BlockKrylov},
-                                                          {"lanczos", EigenSolver::Lanczos}};
   static const auto kLaplacian = by_name({LaplacianType::Cotan, LaplacianType::IntrinsicDelaunay});
   cmd.add_option("--mass", o.mass, "mass matrix: lumped (default) or consistent")
       ->transform(CLI::CheckedTransformer(kMass, CLI::ignore_case));
@@ -161,9 +169,7 @@ void add_harmonics_options(CLI::App& cmd, ManifoldHarmonicsOptions& o) {
                  "cotan (the mesh's triangles, default) or intrinsic-delaunay (robust to slivers "
                  "and non-manifold edges)")
       ->transform(CLI::CheckedTransformer(kLaplacian, CLI::ignore_case));
-  cmd.add_option("--eigensolver", o.solver,
-                 "krylov (block Krylov-Schur, default) or lanczos (Spectra, the baseline)")
-      ->transform(CLI::CheckedTransformer(kSolver, CLI::ignore_case));
+  add_eigensolver_option(cmd, o.solver);
   cmd.add_option("--tolerance", o.tolerance, "eigenpair residual to reach (default 1e-8)")
       ->check(kPositive);
   cmd.add_option("--band-size", o.band_size, "eigenpairs per shift (default: automatic)")
@@ -246,34 +252,20 @@ FrameTimings median_frame(SpectralDeformer& deformer,
   return {median(reduced), median(inverse), median(detail), median(total)};
 }
 
-ManifoldHarmonics obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonicsOptions& options,
-                               const std::string& cache, bool* loaded) {
-  if (loaded != nullptr) *loaded = false;
-  if (!cache.empty() && std::filesystem::exists(cache)) {
-    ManifoldHarmonics h = load_basis(cache, mesh);
-    require_operators(cache, h, options.mass, options.laplacian);
-    if (h.basis.cols() < options.num_modes) {
-      throw InputError(cache + ": holds " + std::to_string(h.basis.cols()) + " frequencies, " +
-                       std::to_string(options.num_modes) + " are asked for");
-    }
-    h.basis.conservativeResize(Eigen::NoChange, options.num_modes);
-    h.eigenvalues.conservativeResize(options.num_modes);
-    if (loaded != nullptr) *loaded = true;
-    return h;
-  }
+std::shared_ptr<const ManifoldHarmonics> obtain_basis(const TriangleMesh& mesh,
+                                                      const ManifoldHarmonicsOptions& options,
+                                                      const std::string& cache, bool* loaded) {
   ManifoldHarmonicsOptions o = options;
   o.progress = progress_bar("manifold harmonics");
-  ManifoldHarmonics h = compute_manifold_harmonics(mesh, o);
-  if (h.status != SolveStatus::Converged) {
-    throw SolverError("manifold harmonics did not converge: " + residual_summary(h));
-  }
-  if (h.cluster_truncated) {
+  ObtainedBasis basis = specdeform::obtain_basis(mesh, o, cache);
+  if (loaded != nullptr) *loaded = basis.loaded;
+  if (!basis.warning.empty()) std::cerr << "warning: " << basis.warning << "\n";
+  if (!basis.loaded && basis.harmonics->cluster_truncated) {
     std::cerr << "note: m = " << options.num_modes
               << " ends inside a cluster of equal eigenvalues; the last basis vectors are one "
                  "arbitrary choice within it\n";
   }
-  if (!cache.empty()) save_basis(cache, h, mesh);
-  return h;
+  return std::move(basis.harmonics);
 }
 
 }  // namespace specdeform::cli

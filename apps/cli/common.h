@@ -36,13 +36,18 @@ LoadedMesh load_mesh(const std::string& path);
 // A progress bar on stderr when it is a terminal; nothing otherwise.
 ProgressCallback progress_bar(const std::string& label);
 
+// Adds --eigensolver krylov|lanczos|multilevel to `cmd`, bound to `solver`.
+void add_eigensolver_option(CLI::App& cmd, EigenSolver& solver);
+
 // Adds --mass/--solver/--tolerance/... to `cmd`, bound to `options`.
 void add_harmonics_options(CLI::App& cmd, ManifoldHarmonicsOptions& options);
 
-// Loads the basis from `cache` if given and it exists, else computes it (and saves it to
-// `cache` if given). Throws SolverError if the computation does not converge.
-ManifoldHarmonics obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonicsOptions& options,
-                               const std::string& cache, bool* loaded = nullptr);
+// The library's obtain_basis (spectral/basis_store.h) with a progress bar, its warning and a
+// note on a truncated cluster on stderr.
+std::shared_ptr<const ManifoldHarmonics> obtain_basis(const TriangleMesh& mesh,
+                                                      const ManifoldHarmonicsOptions& options,
+                                                      const std::string& cache,
+                                                      bool* loaded = nullptr);
 
 // The handle options shared by deform and converge: --sel/--dmat with --def, or --scene.
 // --json FILE and --markdown FILE: a table's rows as JSON and as markdown; write() also prints

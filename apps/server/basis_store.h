@@ -1,4 +1,4 @@
-// The editor's bases: loaded from the cache folder when there, computed (and cached) otherwise.
+// The editor's bases: the library's compute-or-load (spectral/basis_store.h) in the cache folder.
 #pragma once
 
 #include <filesystem>
@@ -10,10 +10,6 @@
 
 namespace specdeform::server {
 
-// The largest basis residual (eigen_residual) the editor works with, warning, when the solver
-// falls short of its tolerance.
-inline constexpr double kUsableResidual = 1e-6;
-
 struct PreparedBasis {
   std::shared_ptr<const ManifoldHarmonics> harmonics;  // null: to be prepared again
   double seconds = 0.0;
@@ -21,10 +17,10 @@ struct PreparedBasis {
   std::string warning;  // shown to the user
 };
 
-// The first `modes` manifold harmonics of `mesh` (lumped mass), from `cache_dir` (empty: no
-// cache) or computed with `progress` (which may throw to abandon the computation) and then
-// cached. Throws SolverError for a basis too inaccurate to use.
-PreparedBasis prepare_basis(const TriangleMesh& mesh, int modes,
+// The first `modes` manifold harmonics of `mesh` (lumped mass) by `solver`, from `cache_dir`
+// (created if missing; empty: no cache) or computed with `progress` (which may throw to abandon
+// the computation) and then cached. Throws SolverError for a basis too inaccurate to use.
+PreparedBasis prepare_basis(const TriangleMesh& mesh, int modes, EigenSolver solver,
                             const std::filesystem::path& cache_dir,
                             const ProgressCallback& progress);
 

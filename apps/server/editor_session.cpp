@@ -551,7 +551,7 @@ PreparedBasis EditorSession::compute_basis(const TriangleMesh& mesh, int modes) 
                        {"fraction", fraction},
                        {"cancellable", true}}));
   };
-  PreparedBasis out = prepare_basis(mesh, modes, config_.cache_dir, report);
+  PreparedBasis out = prepare_basis(mesh, modes, config_.eigensolver, config_.cache_dir, report);
   report(1.0, "factorizing");
   return out;
 }
@@ -613,6 +613,7 @@ void EditorSession::send_ready() {
                           {{"seconds", b.seconds},
                            {"source", b.source},
                            {"residual", b.harmonics->max_residual},
+                           {"approximate", b.harmonics->approximate},
                            {"warning", b.warning}}},
                          {"setup",
                           {{"reduced_system", t.reduced_system},

@@ -61,9 +61,10 @@ inline DeformOptions editor_deform_options() {
 }
 
 struct EditorConfig {
-  int modes = 100;                                  // m of a newly opened mesh
-  DeformOptions options = editor_deform_options();  // solver settings of a newly opened mesh
-  std::filesystem::path cache_dir;                  // basis cache; empty: none
+  int modes = 100;                                     // m of a newly opened mesh
+  DeformOptions options = editor_deform_options();     // solver settings of a newly opened mesh
+  std::filesystem::path cache_dir;                     // basis cache; empty: none
+  EigenSolver eigensolver = EigenSolver::BlockKrylov;  // of the bases it computes
 };
 
 // Thrown from a progress report after cancel(): the computation is abandoned.

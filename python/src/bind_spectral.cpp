@@ -91,6 +91,15 @@ returns (evecs.base). SpectralDeformer shares it without a copy.)")
           "converged", [](const Harmonics& h) { return h.value->status == SolveStatus::Converged; })
       .def_property_readonly("max_residual",
                              [](const Harmonics& h) { return h.value->max_residual; })
+      .def_property_readonly(
+          "residuals",
+          [](py::object self) {
+            return view(self.cast<const Harmonics&>().value->residuals, self);
+          },
+          "(k,) each pair's residual (read-only).")
+      .def_property_readonly("approximate", [](const Harmonics& h) { return h.value->approximate; })
+      .def_property_readonly("coarse_functions",
+                             [](const Harmonics& h) { return h.value->coarse_functions; })
       .def_property_readonly("rounding_floor",
                              [](const Harmonics& h) { return h.value->rounding_floor; })
       .def_property_readonly("threshold", [](const Harmonics& h) { return h.value->threshold; })
@@ -117,10 +126,7 @@ returns (evecs.base). SpectralDeformer shares it without a copy.)")
         o.num_modes = k;
         o.mass = mass_from_name(mass);
         o.tolerance = tolerance;
-        if (eigensolver != "krylov" && eigensolver != "lanczos") {
-          throw InputError("eigensolver: '" + eigensolver + "' is not one of krylov, lanczos");
-        }
-        o.solver = eigensolver == "krylov" ? EigenSolver::BlockKrylov : EigenSolver::Lanczos;
+        o.solver = eigen_solver_from_name(eigensolver);
         o.seed = seed;
         return eigenpairs(obtain_basis(to_mesh(V, F), o, cache, progress));
       },
@@ -139,6 +145,9 @@ written otherwise (the CLI's --basis), or an existing directory of bases named a
 names them (its cache is ~/.cache/specdeform). tolerance: the residual each pair must reach, on
 the mesh scaled to unit area. progress: called as progress(fraction, stage); an exception it
 raises, or Ctrl-C, aborts the computation. The GIL is released while it runs.
+eigensolver: "krylov" (exact, the default), "lanczos" (Spectra, the baseline) or "multilevel"
+(an approximation for large meshes: M-orthonormal, not eigenvectors; Harmonics.approximate
+and .residuals say so; its cache file is kept apart from the exact one's).
 Raises SolverError if the eigensolver does not converge.)");
 
   m.def(

@@ -8,6 +8,7 @@
 #include "specdeform/exceptions.h"
 #include "specdeform/operators/cotan_laplacian.h"
 #include "specdeform/spectral/basis_cache.h"
+#include "specdeform/spectral/basis_store.h"
 
 namespace specdeform::python {
 
@@ -44,15 +45,6 @@ std::shared_ptr<const ManifoldHarmonics> copied_basis(py::handle evals, py::hand
   }
   h->max_residual = eigen_residual(cotan_stiffness(mesh), M, h->basis, h->eigenvalues);
   return h;
-}
-
-std::filesystem::path cache_path(const std::filesystem::path& cache, const TriangleMesh& mesh,
-                                 int modes, MassType mass) {
-  if (!std::filesystem::is_directory(cache)) return cache;
-  char hash[17];
-  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(mesh_hash(mesh)));
-  return cache /
-         (std::string(hash) + "-m" + std::to_string(modes) + "-" + mass_name(mass) + ".sdbasis");
 }
 
 // The first `modes` pairs of `h` (h itself when that is all of them).
@@ -133,43 +125,32 @@ ProgressCallback python_progress(py::handle user) {
 std::shared_ptr<const ManifoldHarmonics> obtain_basis(
     const TriangleMesh& mesh, const ManifoldHarmonicsOptions& options,
     const std::optional<std::filesystem::path>& cache, py::handle progress) {
-  const std::filesystem::path path =
-      cache ? cache_path(*cache, mesh, options.num_modes, options.mass) : "";
-  if (!path.empty() && std::filesystem::exists(path)) {
-    check_readable(path);
-    auto h = std::make_shared<ManifoldHarmonics>();
-    {
-      py::gil_scoped_release release;
-      *h = load_basis(path, mesh);
+  std::filesystem::path path;
+  if (cache) {
+    path = std::filesystem::is_directory(*cache) ? *cache / basis_file_name(mesh, options) : *cache;
+    if (std::filesystem::exists(path)) {
+      check_readable(path);
+    } else {
+      check_writable(path);
     }
-    if (h->mass != options.mass) {
-      throw InputError(path.string() + ": the basis was computed with the other mass matrix");
-    }
-    return first_modes(std::move(h), options.num_modes, path.string());
   }
-  if (!path.empty()) check_writable(path);
   ManifoldHarmonicsOptions o = options;
   o.progress = python_progress(progress);
-  auto h = std::make_shared<ManifoldHarmonics>();
+  ObtainedBasis basis;
   {
     py::gil_scoped_release release;
-    *h = compute_manifold_harmonics(mesh, o);
+    basis = specdeform::obtain_basis(mesh, o, path);
   }
-  if (h->status != SolveStatus::Converged) {
-    throw SolverError("manifold harmonics did not converge: " + residual_summary(*h));
+  std::string message = basis.warning;
+  if (!basis.loaded && basis.harmonics->cluster_truncated) {
+    message = "manifold harmonics: k = " + std::to_string(options.num_modes) +
+              " ends inside a cluster of equal eigenvalues; the last vectors are one arbitrary "
+              "choice within it";
   }
-  if (h->cluster_truncated) {
-    const std::string message =
-        "manifold harmonics: k = " + std::to_string(options.num_modes) +
-        " ends inside a cluster of equal eigenvalues; the last vectors are one arbitrary choice "
-        "within it";
-    if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 2) != 0) throw py::error_already_set();
+  if (!message.empty() && PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 2) != 0) {
+    throw py::error_already_set();
   }
-  if (!path.empty()) {
-    py::gil_scoped_release release;
-    save_basis(path, *h, mesh);
-  }
-  return h;
+  return std::move(basis.harmonics);
 }
 
 MassType mass_from_name(const std::string& name) {

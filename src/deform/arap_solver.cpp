@@ -223,8 +223,8 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
   }
   const VertexClusters clusters = vertex_clusters(TriangleMesh{base, mesh.F}, options.clusters);
   label_ = clusters.label;
-  // The basis's own Laplacian and lumped mass, so that the reduced Hessian's H^T K H and
-  // H^T K M^-1 K H are its eigenvalues and their squares.
+  // The basis's own Laplacian and lumped mass, as the reduced Hessian's H^T K H and
+  // H^T K M^-1 K H use them (spectral_deformer.cpp).
   Sparse K;
   Eigen::VectorXd mass;
   if (basis) {

@@ -2,11 +2,13 @@
 
 #include <chrono>
 
+#include "deform/reduced_forms.h"
 #include "linalg/basis_product.h"
 #include "specdeform/deform/reduced_solver.h"
 #include "specdeform/deform/spatial_solver.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/mesh_info.h"
+#include "specdeform/operators/laplacian.h"
 #include "specdeform/operators/mass_matrix.h"
 #include "specdeform/spectral/spectral_transform.h"
 
@@ -27,14 +29,19 @@ class Clock {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-// The diagonal of the reduced Hessian D (reduced_solver.h) without ARAP's correction for
-// negative cotangent weights; eigenvalues of -1e-14 count as 0.
-Eigen::VectorXd reduced_hessian(const ManifoldHarmonics& basis, double area,
+// The reduced Hessian D (reduced_solver.h) without ARAP's correction for negative cotangent
+// weights, from the basis itself (a basis need not be made of eigenvectors): its Laplacian's
+// stiffness and lumped mass, as the spatial solver and ARAP's rotations use them; the linear
+// energy's bending in the mixed form (deform/reduced_forms.h).
+Eigen::MatrixXd reduced_hessian(const TriangleMesh& mesh, const ManifoldHarmonics& basis,
                                 const DeformOptions& options) {
-  const Eigen::ArrayXd lambda = basis.eigenvalues.array().max(0.0);
+  const LaplacianOperators L = laplacian_operators(mesh, MassType::Lumped, basis.laplacian);
+  const Eigen::VectorXd area = L.mass.diagonal();
   const bool arap = options.energy == DeformEnergy::Arap;
+  const detail::ReducedForms forms = detail::reduced_forms(
+      L.stiffness, area, basis.basis, arap ? detail::Bending::Fine : detail::Bending::Mixed);
   const double ks = arap ? 1.0 : options.ks, kb = arap ? options.arap.bending : options.kb;
-  return (ks * lambda + kb * area * lambda.square()).matrix();
+  return ks * forms.stiffness + (kb * area.sum()) * forms.bending;
 }
 
 }  // namespace
@@ -72,10 +79,10 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
     arap_ = std::make_unique<ArapSolver>(mesh_, base_, spectral ? basis_ : nullptr, options_.arap);
   }
   if (spectral) {
-    Eigen::MatrixXd hessian = reduced_hessian(*basis_, area.sum(), options_).asDiagonal();
+    Eigen::MatrixXd hessian = reduced_hessian(mesh_, *basis_, options_);
     if (arap_) hessian += arap_->membrane_correction();
-    reduced_ = std::make_unique<ReducedSolver>(basis_, std::move(hessian), area / area.sum(),
-                                               options_);
+    reduced_ =
+        std::make_unique<ReducedSolver>(basis_, std::move(hessian), area / area.sum(), options_);
     if (options_.float32_basis) basis32_ = basis_->basis.cast<float>();
   } else {
     spatial_ = std::make_unique<SpatialSolver>(mesh_, options_);

@@ -15,7 +15,8 @@ namespace specdeform {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'D', 'B', 'A', 'S', 'I', 'S', '\0'};
-constexpr uint32_t kVersion = 3;  // 1: no Laplacian byte (cotan); 1 and 2: no solver report
+constexpr uint32_t kVersion = 4;  // 1: no Laplacian byte (cotan); 1 and 2: no solver report;
+                                  // 1 to 3: exact bases only, no residuals per pair
 constexpr size_t kHeaderSize = 8 + 4 + 4 + 4 + 1 + 1 + 1 + 1 + 8;
 constexpr size_t kReportSize = 4 * 8 + 4 + 4 + 8 + 8;
 
@@ -59,7 +60,7 @@ void save_basis(const std::filesystem::path& path, const ManifoldHarmonics& basi
   }
   const bool single = precision == BasisPrecision::Float32;
   std::string out;
-  out.reserve(kHeaderSize + kReportSize + 8 * size_t(m) + (single ? 4 : 8) * size_t(n) * m);
+  out.reserve(kHeaderSize + kReportSize + 16 * size_t(m) + (single ? 4 : 8) * size_t(n) * m);
   out.append(kMagic, 8);
   put(out, kVersion);
   put(out, n);
@@ -78,8 +79,14 @@ void save_basis(const std::filesystem::path& path, const ManifoldHarmonics& basi
   put(out, static_cast<uint64_t>(basis.solves));
   put(out, static_cast<uint8_t>(basis.status == SolveStatus::Converged ? 1 : 0));
   put(out, static_cast<uint8_t>(basis.cluster_truncated ? 1 : 0));
-  out.append(6, '\0');
+  put(out, static_cast<uint8_t>(basis.approximate ? 1 : 0));
+  put(out, static_cast<uint32_t>(basis.coarse_functions));
+  out.append(1, '\0');
   out.append(reinterpret_cast<const char*>(basis.eigenvalues.data()), 8 * size_t(m));
+  const Eigen::VectorXd residuals = basis.residuals.size() == m
+                                        ? basis.residuals
+                                        : Eigen::VectorXd::Constant(m, basis.max_residual);
+  out.append(reinterpret_cast<const char*>(residuals.data()), 8 * size_t(m));
   if (single) {
     const Eigen::MatrixXf H = basis.basis.cast<float>();
     out.append(reinterpret_cast<const char*>(H.data()), 4 * size_t(n) * m);
@@ -131,6 +138,8 @@ ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMe
     out.solves = static_cast<long long>(get<uint64_t>(r));
     out.status = get<uint8_t>(r) == 1 ? SolveStatus::Converged : SolveStatus::NotConverged;
     out.cluster_truncated = get<uint8_t>(r) == 1;
+    out.approximate = get<uint8_t>(r) == 1;
+    out.coarse_functions = static_cast<int>(get<uint32_t>(r));
   } else {
     out.max_residual = std::numeric_limits<double>::quiet_NaN();  // not recorded
   }
@@ -140,6 +149,10 @@ ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMe
   out.basis.resize(n, m);
   bool ok =
       static_cast<bool>(file.read(reinterpret_cast<char*>(out.eigenvalues.data()), 8 * size_t(m)));
+  out.residuals = Eigen::VectorXd::Constant(m, out.max_residual);
+  if (ok && version >= 4) {
+    ok = static_cast<bool>(file.read(reinterpret_cast<char*>(out.residuals.data()), 8 * size_t(m)));
+  }
   if (ok && scalar == 8) {
     ok = static_cast<bool>(file.read(reinterpret_cast<char*>(out.basis.data()), 8 * size_t(n) * m));
   } else if (ok) {

@@ -4,7 +4,9 @@
 //  - solve_lanczos: Spectra's shift-invert Lanczos on CHOLMOD, the plain baseline;
 //  - solve_block_krylov: K's null space (the constants of each connected component) exactly,
 //    then bands of pairs by shift-invert block Krylov-Schur (linalg/krylov_schur.h), the first
-//    below the spectrum, later ones at interior shifts, each deflated against the pairs found.
+//    below the spectrum, later ones at interior shifts, each deflated against the pairs found;
+//  - solve_multilevel: an approximation (spectral/multilevel.cpp): the Galerkin projection onto
+//    a coarse partition-of-unity space (spectral/coarse_space.h), solved exactly there.
 #pragma once
 
 #include <Eigen/Core>
@@ -21,6 +23,7 @@ struct Spectrum {
   int bands = 0, restarts = 0;
   long long solves = 0;
   bool cluster_truncated = false;  // lambda_m (nearly) equals lambda_{m+1}
+  int coarse_functions = 0;        // solve_multilevel: N
 };
 
 Spectrum solve_dense(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M,
@@ -30,6 +33,12 @@ Spectrum solve_lanczos(const Eigen::SparseMatrix<double>& K, const Eigen::Sparse
 Spectrum solve_block_krylov(const Eigen::SparseMatrix<double>& K,
                             const Eigen::SparseMatrix<double>& M,
                             const ManifoldHarmonicsOptions& options);
+
+// lengths: K's edges with their lengths (coarse_space.h), for the coarse space's distances.
+Spectrum solve_multilevel(const Eigen::SparseMatrix<double>& K,
+                          const Eigen::SparseMatrix<double>& M,
+                          const Eigen::SparseMatrix<double>& lengths,
+                          const ManifoldHarmonicsOptions& options);
 
 // K's null space, known exactly: the constants on each connected component of K's graph,
 // M-normalised; n x (number of components).

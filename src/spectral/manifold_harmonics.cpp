@@ -1,6 +1,7 @@
 #include "specdeform/spectral/manifold_harmonics.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -8,6 +9,7 @@
 
 #include "linalg/mass_operator.h"
 #include "specdeform/exceptions.h"
+#include "spectral/coarse_space.h"
 #include "spectral/eigen_residual.h"
 #include "spectral/eigensolvers.h"
 
@@ -16,6 +18,21 @@ namespace specdeform {
 using Mat = Eigen::MatrixXd;
 using Vec = Eigen::VectorXd;
 using Sparse = Eigen::SparseMatrix<double>;
+
+namespace {
+constexpr std::array<std::string_view, 3> kSolverNames{"krylov", "lanczos", "multilevel"};
+}  // namespace
+
+std::string_view name(EigenSolver solver) {
+  return kSolverNames[static_cast<size_t>(solver)];
+}
+
+EigenSolver eigen_solver_from_name(std::string_view name) {
+  for (size_t i = 0; i < kSolverNames.size(); ++i)
+    if (kSolverNames[i] == name) return static_cast<EigenSolver>(i);
+  throw InputError("unknown eigensolver '" + std::string(name) +
+                   "' (krylov, lanczos or multilevel)");
+}
 
 void ManifoldHarmonicsPolicy::validate() const {
   const auto require = [](bool ok, const char* what) {
@@ -28,6 +45,13 @@ void ManifoldHarmonicsPolicy::validate() const {
   require(near_radius >= 0.0, "near_radius must be >= 0");
   require(krylov_margin > 0.0 && krylov_margin <= 1.0, "krylov_margin must be in (0, 1]");
   require(redo_factor >= 1.0 && floor_factor >= 1.0, "redo_factor and floor_factor must be >= 1");
+  require(multilevel_samples_per_mode >= 1 && multilevel_min_samples >= 1,
+          "multilevel sample counts must be >= 1");
+  require(multilevel_support > 1.0, "multilevel_support must be > 1");
+  require(multilevel_reduction >= 1, "multilevel_reduction must be >= 1");
+  require(multilevel_smoothing >= 0, "multilevel_smoothing must be >= 0");
+  require(multilevel_omega > 0.0 && multilevel_omega <= 1.0, "multilevel_omega must be in (0, 1]");
+  require(multilevel_oversampling >= 0.0, "multilevel_oversampling must be >= 0");
 }
 
 void ManifoldHarmonicsOptions::validate() const {
@@ -65,8 +89,11 @@ double orthonormality_error(const Sparse& M, const Mat& H) {
   return worst;
 }
 
-ManifoldHarmonics compute_manifold_harmonics(const Sparse& K, const Sparse& M,
-                                             const ManifoldHarmonicsOptions& o) {
+namespace {
+
+// Both overloads: `lengths` gives the multilevel solver's distances (coarse_space.h).
+ManifoldHarmonics harmonics(const Sparse& K, const Sparse& M, const Sparse* lengths,
+                            const ManifoldHarmonicsOptions& o) {
   o.validate();
   const int n = static_cast<int>(K.rows());
   const int m = o.num_modes;
@@ -87,9 +114,16 @@ ManifoldHarmonics compute_manifold_harmonics(const Sparse& K, const Sparse& M,
   const Sparse M_unit = M / area;
 
   detail::Spectrum s;
-  const int first_band = std::min(m, o.policy.single_band_limit) + 2;
-  const bool dense = n <= o.policy.dense_limit || 3 * m > 2 * n || 4 * first_band > n;
-  if (dense) {
+  const ManifoldHarmonicsPolicy& p = o.policy;
+  const int first_band = std::min(m, p.single_band_limit) + 2;
+  const bool dense = n <= p.dense_limit || 3 * m > 2 * n || 4 * first_band > n;
+  const int samples = std::max(p.multilevel_min_samples, p.multilevel_samples_per_mode * m);
+  const bool multilevel = o.solver == EigenSolver::Multilevel &&
+                          static_cast<double>(n) >= double(p.multilevel_reduction) * samples;
+  if (multilevel) {
+    s = detail::solve_multilevel(K, M_unit,
+                                 lengths ? *lengths : detail::estimated_edge_lengths(K, M_unit), o);
+  } else if (dense) {
     if (n > 6000) {
       throw InputError("manifold harmonics: m = " + std::to_string(m) + " is too close to n = " +
                        std::to_string(n) + " for an iterative solver; use m <= 2n/3");
@@ -104,6 +138,8 @@ ManifoldHarmonics compute_manifold_harmonics(const Sparse& K, const Sparse& M,
   ManifoldHarmonics out;
   out.status = s.status;
   out.cluster_truncated = s.cluster_truncated;
+  out.approximate = multilevel;
+  out.coarse_functions = s.coarse_functions;
   out.bands = s.bands;
   out.restarts = s.restarts;
   out.solves = s.solves;
@@ -117,18 +153,33 @@ ManifoldHarmonics compute_manifold_harmonics(const Sparse& K, const Sparse& M,
   }
   detail::report(o, 1.0, "verification");
   const detail::PairErrors errors = detail::pair_errors(K, M, out.basis, out.eigenvalues);
+  out.residuals = errors.residual;
   out.max_residual = errors.residual.maxCoeff();
   out.rounding_floor = errors.floor.maxCoeff();
-  out.threshold = errors.thresholds(o.tolerance, o.policy.floor_factor).maxCoeff();
+  out.threshold = errors.thresholds(o.tolerance, p.floor_factor).maxCoeff();
   out.max_orthogonality_error = orthonormality_error(M, out.basis);
-  if (!errors.within(o.tolerance, o.policy.floor_factor)) out.status = SolveStatus::NotConverged;
+  // An approximate basis is not meant to meet the tolerance: its status is the coarse solve's.
+  if (!multilevel && !errors.within(o.tolerance, p.floor_factor)) {
+    out.status = SolveStatus::NotConverged;
+  }
   return out;
+}
+
+}  // namespace
+
+ManifoldHarmonics compute_manifold_harmonics(const Sparse& K, const Sparse& M,
+                                             const ManifoldHarmonicsOptions& o) {
+  return harmonics(K, M, nullptr, o);
 }
 
 ManifoldHarmonics compute_manifold_harmonics(const TriangleMesh& mesh,
                                              const ManifoldHarmonicsOptions& options) {
   const LaplacianOperators L = laplacian_operators(mesh, options.mass, options.laplacian);
-  ManifoldHarmonics h = compute_manifold_harmonics(L.stiffness, L.mass, options);
+  const Sparse lengths = options.solver == EigenSolver::Multilevel
+                             ? detail::edge_lengths(L.stiffness, mesh.V)
+                             : Sparse();
+  ManifoldHarmonics h = harmonics(
+      L.stiffness, L.mass, options.solver == EigenSolver::Multilevel ? &lengths : nullptr, options);
   h.mass = options.mass;
   h.laplacian = options.laplacian;
   return h;

@@ -112,7 +112,7 @@ def test_basis_file_round_trip_and_cache(tmp_path, bar):
     np.testing.assert_array_equal(first_vecs, evecs[:, :5])
     with pytest.raises(specdeform.InputError, match="holds 12 frequencies, 20 are asked for"):
         specdeform.manifold_harmonics(V, F, 20, cache=path)
-    with pytest.raises(specdeform.InputError, match="other mass"):
+    with pytest.raises(specdeform.InputError, match="lumped mass matrix, not the consistent"):
         specdeform.manifold_harmonics(V, F, 5, cache=path, mass="consistent")
     with pytest.raises(specdeform.InputError, match="another mesh"):
         specdeform.manifold_harmonics(V * 2, F, 5, cache=path)
@@ -261,3 +261,20 @@ def test_cholmod_prints_nothing(capfd, bar):
     config = ctypes.c_void_p.in_dll(ctypes.CDLL("libsuitesparseconfig.so.5"), "SuiteSparse_config")
     hooks = ctypes.cast(ctypes.addressof(config), ctypes.POINTER(ctypes.c_void_p))
     assert hooks[4] is None  # malloc, calloc, realloc, free, then printf
+
+
+def test_multilevel_basis_is_orthonormal_and_cached_apart(tmp_path):
+    # An approximate basis: exactly M-orthonormal, its eigenvalues above the exact ones (a
+    # Galerkin projection), its residuals reported per pair, its cache file named apart.
+    V, F = specdeform.icosphere(5)
+    exact, _ = specdeform.manifold_harmonics(V, F, 16, cache=tmp_path)
+    evals, evecs = specdeform.manifold_harmonics(V, F, 16, eigensolver="multilevel", cache=tmp_path)
+    h = evecs.base
+    assert h.approximate and h.coarse_functions == 500 and h.converged
+    assert h.residuals.shape == (16,) and h.residuals.max() == h.max_residual > 1e-4
+    M = specdeform.mass_matrix(V, F)
+    assert abs(evecs.T @ (M @ evecs) - np.eye(16)).max() < 1e-10
+    assert np.all(evals[1:] >= exact[1:] - 1e-9) and np.all(evals[1:] <= 1.05 * exact[1:])
+    assert sorted(p.name.endswith("-multilevel.sdbasis") for p in tmp_path.iterdir()) == [False, True]
+    again, _ = specdeform.manifold_harmonics(V, F, 16, eigensolver="multilevel", cache=tmp_path)
+    np.testing.assert_array_equal(again, evals)

@@ -71,24 +71,34 @@ TEST_F(BasisCache, RecordsTheLaplacian) {
       InputError);
 }
 
-// Rewrites a file of this version as an older one: that version number, without the solver
-// report (56 bytes after the 32-byte header) that version 3 added.
-void downgrade(const std::filesystem::path& path, uint32_t version) {
+// Rewrites a file of this version (m pairs) as an older one: that version number, without the
+// residuals per pair (8 m bytes after the eigenvalues) that version 4 added and, before
+// version 3, without the solver report (56 bytes after the 32-byte header).
+void downgrade(const std::filesystem::path& path, uint32_t version, size_t m) {
   std::string bytes;
   {
     std::ifstream file(path, std::ios::binary);
     bytes.assign(std::istreambuf_iterator<char>(file), {});
   }
-  bytes.erase(32, 56);
+  bytes.erase(32 + 56 + 8 * m, 8 * m);
+  if (version < 3) bytes.erase(32, 56);
   std::memcpy(bytes.data() + 8, &version, sizeof version);
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
 }
 
-TEST_F(BasisCache, ReadsVersionsOneAndTwo) {
+TEST_F(BasisCache, ReadsVersionsOneToThree) {
+  // Version 3 has the report without the residuals per pair (and only exact bases).
+  save_basis(dir_ / "b.sdbasis", h_, mesh_);
+  downgrade(dir_ / "b.sdbasis", 3, h_.basis.cols());
+  const ManifoldHarmonics three = load_basis(dir_ / "b.sdbasis", mesh_);
+  EXPECT_EQ(three.basis, h_.basis);
+  EXPECT_EQ(three.max_residual, h_.max_residual);
+  EXPECT_EQ(three.residuals, Eigen::VectorXd::Constant(h_.basis.cols(), h_.max_residual));
+  EXPECT_FALSE(three.approximate);
   // Version 1 had a reserved zero where version 2 keeps the Laplacian; neither has the report.
   for (const uint32_t version : {1u, 2u}) {
     save_basis(dir_ / "b.sdbasis", h_, mesh_);
-    downgrade(dir_ / "b.sdbasis", version);
+    downgrade(dir_ / "b.sdbasis", version, h_.basis.cols());
     const ManifoldHarmonics back = load_basis(dir_ / "b.sdbasis", mesh_);
     EXPECT_EQ(back.laplacian, LaplacianType::Cotan);
     EXPECT_EQ(back.basis, h_.basis);
@@ -96,7 +106,7 @@ TEST_F(BasisCache, ReadsVersionsOneAndTwo) {
   }
   {
     std::fstream file(dir_ / "b.sdbasis", std::ios::in | std::ios::out | std::ios::binary);
-    const uint32_t version = 4;
+    const uint32_t version = 5;
     file.seekp(8);
     file.write(reinterpret_cast<const char*>(&version), sizeof version);
   }

@@ -20,8 +20,8 @@
 // With d = H c and the cluster operator Q (3k x m; over all vertices the sparse 3k x n operator
 // with the identity for H), the covariance of cluster k is S_k = S_k(s) + Q_k c (3 x 3) and
 //     E(c, R) = tr(c^T D c) - sum_k tr((R_k - I) S_k) + constraints + const,
-// D = Lambda + b A Lambda^2 + H^T (K+ - K) H the reduced Hessian that ReducedSolver factors once
-// per selection (reduced_solver.h):
+// D = H^T K H + b A H^T K M^-1 K H + H^T (K+ - K) H the reduced Hessian that ReducedSolver
+// factors once per selection (reduced_solver.h; Lambda + b A Lambda^2 + ... for eigenvectors):
 //  - local step: R_k maximises tr(R_k S_k) (a closed-form polar decomposition, reflections
 //    excluded): O(k m) per iteration;
 //  - the energy's gradient in c, with the rotations optimal for c, is 2 (D c - 1/2 Q^T (R - I))

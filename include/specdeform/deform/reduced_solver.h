@@ -2,10 +2,13 @@
 // done as in the technical notes rather than literally).
 //
 // With d = H c, H the n x m manifold harmonics (H^T M H = I, mesh units), every energy of
-// deform_options.h has a reduced Hessian D (m x m), the same for x, y and z:
-//     linear:  D = ks Lambda + kb A Lambda^2     (A = surface area: unit-area scaling; diagonal)
-//     ARAP:    D = Lambda + b A Lambda^2 + H^T (K+ - K) H   (its global step; arap_solver.h:
-//              dense where the mesh has negative cotangent weights, else diagonal)
+// deform_options.h has a reduced Hessian D (m x m), the same for x, y and z, formed from H
+// itself (M_l the lumped mass, A the surface area: unit-area scaling):
+//     linear:  D = ks H^T K H + kb A H^T K M_l^-1 K H    (ks Lambda + kb A Lambda^2 for exact
+//              eigenvectors: diagonal)
+//     ARAP:    D = H^T K H + b A H^T K M_l^-1 K H + H^T (K+ - K) H   (its global step;
+//              arap_solver.h)
+// so that it is exact for any M-orthonormal basis, eigenvectors or not (multilevel).
 // This solver minimises, over the coefficients c (m x 3),
 //     E(c) = tr(c^T D c) - 2 tr(c^T g) + constraints
 // for a linear term g (m x 3; zero for the linear energy). No n x n product is ever formed.

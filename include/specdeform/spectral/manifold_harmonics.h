@@ -20,6 +20,14 @@
 //    component) is known exactly and deflated from the start.
 //  - Lanczos: Spectra's SymGEigsShiftSolver (implicitly restarted Lanczos, ncv = 2m + 1) on the
 //    same CHOLMOD shift-invert operator. The plain baseline.
+//  - Multilevel: an approximation for large meshes (Nasikun, Brandt & Hildebrandt, "Fast
+//    approximation of Laplace-Beltrami eigenproblems", SGP 2018): the Galerkin projection of the
+//    problem onto N ~ 10 m locally supported partition-of-unity functions P of the graph distance
+//    around farthest-point samples, P^T K P z = lambda P^T M P z solved exactly, H = P Z. H is
+//    exactly M-orthonormal and H^T K H = Lambda, so the low pass, the detail split and every
+//    deformation energy (computed from H itself) stay exact in its span; but H is not made of
+//    eigenvectors of K and M (`approximate`; the residuals say how far). Linear in n: no fine
+//    factorisation. Meshes of fewer than multilevel_reduction * N vertices get the exact solver.
 // Each eigenvector's sign is fixed so that its entry of largest magnitude is positive; random
 // start vectors are seeded, so the output is reproducible. Several connected components give
 // one zero eigenvalue each. If m ends inside a cluster of (nearly) equal eigenvalues, the
@@ -40,7 +48,11 @@
 
 namespace specdeform {
 
-enum class EigenSolver { BlockKrylov, Lanczos };
+enum class EigenSolver { BlockKrylov, Lanczos, Multilevel };
+
+// "krylov", "lanczos" or "multilevel"; eigen_solver_from_name throws InputError for another name.
+std::string_view name(EigenSolver solver);
+EigenSolver eigen_solver_from_name(std::string_view name);
 
 // Called now and then during long computations: fraction done in [0, 1] and the stage's name.
 using ProgressCallback = std::function<void(double fraction, std::string_view stage)>;
@@ -62,6 +74,17 @@ struct ManifoldHarmonicsPolicy {
                                 // that the verified residuals meet the tolerance itself
   double redo_factor = 10;      // an interior band this far above its thresholds is redone
   double floor_factor = 100;    // a pair's threshold: max(tolerance, this * its rounding floor)
+  // Multilevel: N = max(samples_per_mode * m, min_samples) coarse functions of support radius
+  // `support` times the sampling's covering radius; meshes of fewer than reduction * N vertices
+  // are solved exactly; `smoothing` Jacobi steps (damping omega) and a Rayleigh-Ritz over
+  // (1 + oversampling) m vectors refine the prolonged ones (0: none).
+  int multilevel_samples_per_mode = 10;
+  int multilevel_min_samples = 500;
+  double multilevel_support = 2.5;
+  int multilevel_reduction = 4;
+  int multilevel_smoothing = 0;
+  double multilevel_omega = 2.0 / 3.0;
+  double multilevel_oversampling = 0.5;
 
   void validate() const;  // throws InputError
 };
@@ -94,12 +117,17 @@ struct ManifoldHarmonics {
   // Converged: every pair's residual is within its threshold, max(tolerance,
   // floor_factor * its rounding floor); `threshold` is the largest threshold applied.
   SolveStatus status = SolveStatus::Converged;
-  double max_residual = 0.0;             // max over pairs, as `tolerance` defines it
+  Eigen::VectorXd residuals;             // per pair, as `tolerance` defines it
+  double max_residual = 0.0;             // their max
   double rounding_floor = 0.0;           // max over pairs of the rounding error of K h - l M h
   double threshold = 0.0;                // max over pairs of the threshold applied
   double max_orthogonality_error = 0.0;  // max |H^T M H - I|
   bool cluster_truncated = false;        // lambda_m is (nearly) equal to lambda_{m+1}
-  int bands = 0;                         // shifts used (= factorizations)
+  // Multilevel: the basis spans a coarse space of this many functions and is not made of
+  // eigenvectors; `status` is the coarse solve's and the residuals measure the approximation.
+  bool approximate = false;
+  int coarse_functions = 0;
+  int bands = 0;  // shifts used (= factorizations)
   int restarts = 0;
   long long solves = 0;  // right-hand sides solved with the factorization
 };

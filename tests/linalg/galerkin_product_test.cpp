@@ -1,0 +1,48 @@
+#include "linalg/galerkin_product.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+namespace specdeform {
+namespace {
+
+using Sparse = Eigen::SparseMatrix<double>;
+
+// A random sparse matrix with about `per_column` entries per column.
+Sparse random_sparse(int rows, int cols, int per_column, std::mt19937_64& rng) {
+  std::uniform_int_distribution<int> row(0, rows - 1);
+  std::normal_distribution<double> value;
+  std::vector<Eigen::Triplet<double>> t;
+  for (int j = 0; j < cols; ++j)
+    for (int k = 0; k < per_column; ++k) t.emplace_back(row(rng), j, value(rng));
+  Sparse A(rows, cols);
+  A.setFromTriplets(t.begin(), t.end());
+  return A;
+}
+
+// Against the plain sparse product, for a symmetric A with and without off-diagonal entries,
+// with columns of P that share rows and an empty column.
+TEST(GalerkinProduct, MatchesTheSparseProduct) {
+  std::mt19937_64 rng(7);
+  const Sparse B = random_sparse(400, 400, 5, rng);
+  const Sparse symmetric = Sparse(B + Sparse(B.transpose()));
+  Sparse diagonal(400, 400);
+  for (int i = 0; i < 400; ++i) diagonal.insert(i, i) = 1.0 + i;
+  Sparse P = random_sparse(400, 41, 12, rng);
+  P.col(40) *= 0.0;
+  P.prune(0.0);
+  for (const Sparse& A : {symmetric, diagonal}) {
+    const Eigen::MatrixXd expected = Eigen::MatrixXd(P.transpose() * A * P);
+    const Sparse C = detail::galerkin_product(A, P);
+    ASSERT_EQ(C.rows(), 41);
+    ASSERT_EQ(C.cols(), 41);
+    EXPECT_LT((Eigen::MatrixXd(C) - expected).cwiseAbs().maxCoeff(),
+              1e-12 * expected.cwiseAbs().maxCoeff());
+    EXPECT_EQ((Eigen::MatrixXd(C) - Eigen::MatrixXd(C).transpose()).cwiseAbs().maxCoeff(), 0.0);
+  }
+}
+
+}  // namespace
+}  // namespace specdeform

@@ -1,0 +1,66 @@
+#include "spectral/coarse_space.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "specdeform/mesh/generate.h"
+#include "specdeform/mesh/mesh_info.h"
+#include "specdeform/operators/cotan_laplacian.h"
+#include "specdeform/operators/mass_matrix.h"
+#include "support/corpus.h"
+
+namespace specdeform {
+namespace {
+
+using Sparse = Eigen::SparseMatrix<double>;
+
+// A partition of unity of non-negative functions, each inside one connected component, every
+// component seeded, for the corpus's meshes and both kinds of lengths.
+TEST(CoarseSpace, PartitionOfUnityOverEveryComponent) {
+  for (const test::CorpusMesh& c : test::corpus()) {
+    const TriangleMesh& mesh = c.mesh;
+    const Sparse K = cotan_stiffness(mesh);
+    const Sparse M = mass_matrix(mesh, MassType::Lumped);
+    int components = 0;
+    const Eigen::VectorXi piece = vertex_components(mesh, &components);
+    for (const Sparse& lengths :
+         {detail::edge_lengths(K, mesh.V), detail::estimated_edge_lengths(K, M)}) {
+      const int samples = std::max(components, mesh.num_vertices() / 20);
+      const detail::CoarseSpace space = detail::partition_of_unity(lengths, samples, 2.5);
+      const Sparse& P = space.prolongation;
+      ASSERT_EQ(P.rows(), mesh.num_vertices()) << c.name;
+      ASSERT_EQ(P.cols(), samples) << c.name;
+      EXPECT_GT(space.radius, 0.0) << c.name;
+      const Eigen::VectorXd sums = P * Eigen::VectorXd::Ones(P.cols());
+      EXPECT_LT((sums.array() - 1.0).abs().maxCoeff(), 1e-14) << c.name;
+      std::set<int> seeded;
+      for (int j = 0; j < P.outerSize(); ++j) {
+        std::set<int> pieces;
+        for (Sparse::InnerIterator it(P, j); it; ++it) {
+          EXPECT_GE(it.value(), 0.0);
+          pieces.insert(piece[it.row()]);
+        }
+        EXPECT_EQ(pieces.size(), 1u) << c.name << ": function " << j;
+        seeded.insert(pieces.begin(), pieces.end());
+      }
+      EXPECT_EQ(static_cast<int>(seeded.size()), components) << c.name;
+    }
+  }
+}
+
+// Farthest-point sampling spreads the seeds: on a sphere every vertex lies within the covering
+// radius of a seed, and that radius is about what N equal discs need.
+TEST(CoarseSpace, CoveringRadiusOfEvenSamples) {
+  const TriangleMesh sphere = make_icosphere(4);  // 2,562 vertices, area 4 pi
+  const Sparse K = cotan_stiffness(sphere);
+  const int N = 100;
+  const detail::CoarseSpace space =
+      detail::partition_of_unity(detail::edge_lengths(K, sphere.V), N, 2.5);
+  const double disc = std::sqrt(4.0 / N);  // pi r^2 N = 4 pi
+  EXPECT_GT(space.radius, 0.8 * disc);
+  EXPECT_LT(space.radius, 1.6 * disc);
+}
+
+}  // namespace
+}  // namespace specdeform
