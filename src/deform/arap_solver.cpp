@@ -10,6 +10,7 @@
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
+#include "deform/reduced_forms.h"
 #include "linalg/basis_product.h"
 #include "membrane_stiffness.h"
 #include "specdeform/exceptions.h"
@@ -212,6 +213,21 @@ Sparse bending_operator(const Sparse& K, const Eigen::VectorXd& mass, const Vert
   return B;
 }
 
+// The mixed form's bending covariance weights, 3k x n: cluster k's rows hold, in vertex i's
+// column, a_i l_i for the projected curvature l_i (the row i of `curvature`) and the lumped area
+// a_i, so that applied to curvatures (n x 3) they give sum_{i in k} a_i l_i l'_i^T.
+Sparse curvature_weights(const Eigen::MatrixX3d& curvature, const Eigen::VectorXd& mass,
+                         const Eigen::VectorXi& label, int clusters) {
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(3 * static_cast<size_t>(curvature.rows()));
+  for (int i = 0; i < curvature.rows(); ++i)
+    for (int d = 0; d < 3; ++d)
+      entries.emplace_back(3 * label[i] + d, i, mass[i] * curvature(i, d));
+  Sparse W(3 * clusters, curvature.rows());
+  W.setFromTriplets(entries.begin(), entries.end());
+  return W;
+}
+
 }  // namespace
 
 ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
@@ -223,8 +239,7 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
   }
   const VertexClusters clusters = vertex_clusters(TriangleMesh{base, mesh.F}, options.clusters);
   label_ = clusters.label;
-  // The basis's own Laplacian and lumped mass, as the reduced Hessian's H^T K H and
-  // H^T K M^-1 K H use them (spectral_deformer.cpp).
+  // The basis's own Laplacian and lumped mass.
   Sparse K;
   Eigen::VectorXd mass;
   if (basis) {
@@ -235,12 +250,10 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
     K = cotan_stiffness(mesh);
     mass = lumped_mass(mesh);
   }
-  const Sparse membrane = detail::membrane_stiffness(K);
   // Membrane and bending, as the linear energy's ks = 1 and kb = bending (unit-area scale).
-  const Sparse A = cluster_operator(membrane, base, label_, clusters.count) +
-                   (2.0 * options.bending * mass.sum()) *
-                       bending_operator(K, mass, base, label_, clusters.count);
-  rest_ = A * base;
+  const Sparse stretch =
+      cluster_operator(detail::membrane_stiffness(K), base, label_, clusters.count);
+  const double bend = 2.0 * options.bending * mass.sum();
   // The mean over each cluster's vertices (k x n), applied to the basis when there is one.
   Eigen::VectorXd size = Eigen::VectorXd::Zero(clusters.count);
   for (int i = 0; i < label_.size(); ++i) size[label_[i]] += 1.0;
@@ -265,11 +278,25 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
     for (size_t e = 0; e < dropped.size(); ++e)
       differences.row(e) = weight[e] * (H.row(dropped[e].first) - H.row(dropped[e].second));
     membrane_correction_ = differences.transpose() * differences;
-    reduced_ = A * basis->basis;
+    // Bending in the mixed form (deform/reduced_forms.h): a curvature M^-1 K s' taken as its
+    // projection H S c' onto the span, s' = H c', S = H^T K H; the base's coefficients a from
+    // the basis's own mass.
+    const Eigen::MatrixXd S = detail::reduced_stiffness(K, H);
+    const bool lumped = basis->mass == MassType::Lumped;
+    const Sparse own_mass =
+        lumped ? Sparse(mass.asDiagonal()) : mass_matrix(mesh, basis->mass, basis->laplacian);
+    const Eigen::MatrixXd HS = H * S;
+    const Eigen::MatrixX3d curvature = HS * (H.transpose() * (own_mass * base));
+    const Sparse weights = curvature_weights(curvature, mass, label_, clusters.count);
+    reduced_ = stretch * H + bend * (weights * HS);
+    rest_ = stretch * base + bend * (weights * curvature);
+    reduced_hessian_ =
+        S + 0.5 * bend * detail::reduced_bending(S, mass, H, lumped) + membrane_correction_;
     reduced_transposed_ = reduced_.transpose();
-    reduced_mean_ = cluster_mean * basis->basis;
+    reduced_mean_ = cluster_mean * H;
   } else {
-    operator_ = A;
+    operator_ = stretch + bend * bending_operator(K, mass, base, label_, clusters.count);
+    rest_ = operator_ * base;
     mean_ = cluster_mean;
   }
 }

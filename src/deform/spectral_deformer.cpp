@@ -29,19 +29,17 @@ class Clock {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-// The reduced Hessian D (reduced_solver.h) without ARAP's correction for negative cotangent
-// weights, from the basis itself (a basis need not be made of eigenvectors): its Laplacian's
-// stiffness and lumped mass, as the spatial solver and ARAP's rotations use them; the linear
-// energy's bending in the mixed form (deform/reduced_forms.h).
-Eigen::MatrixXd reduced_hessian(const TriangleMesh& mesh, const ManifoldHarmonics& basis,
-                                const DeformOptions& options) {
+// The linear energy's reduced Hessian D (reduced_solver.h), from the basis itself (a basis need
+// not be made of eigenvectors): its Laplacian's stiffness, and the bending in the mixed form of
+// deform/reduced_forms.h (the spatial solver's lumped mass).
+Eigen::MatrixXd linear_hessian(const TriangleMesh& mesh, const ManifoldHarmonics& basis,
+                               const DeformOptions& options) {
   const LaplacianOperators L = laplacian_operators(mesh, MassType::Lumped, basis.laplacian);
   const Eigen::VectorXd area = L.mass.diagonal();
-  const bool arap = options.energy == DeformEnergy::Arap;
-  const detail::ReducedForms forms = detail::reduced_forms(
-      L.stiffness, area, basis.basis, arap ? detail::Bending::Fine : detail::Bending::Mixed);
-  const double ks = arap ? 1.0 : options.ks, kb = arap ? options.arap.bending : options.kb;
-  return ks * forms.stiffness + (kb * area.sum()) * forms.bending;
+  const Eigen::MatrixXd S = detail::reduced_stiffness(L.stiffness, basis.basis);
+  return options.ks * S +
+         (options.kb * area.sum()) *
+             detail::reduced_bending(S, area, basis.basis, basis.mass == MassType::Lumped);
 }
 
 }  // namespace
@@ -79,10 +77,9 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
     arap_ = std::make_unique<ArapSolver>(mesh_, base_, spectral ? basis_ : nullptr, options_.arap);
   }
   if (spectral) {
-    Eigen::MatrixXd hessian = reduced_hessian(mesh_, *basis_, options_);
-    if (arap_) hessian += arap_->membrane_correction();
-    reduced_ =
-        std::make_unique<ReducedSolver>(basis_, std::move(hessian), area / area.sum(), options_);
+    reduced_ = std::make_unique<ReducedSolver>(
+        basis_, arap_ ? arap_->reduced_hessian() : linear_hessian(mesh_, *basis_, options_),
+        area / area.sum(), options_);
     if (options_.float32_basis) basis32_ = basis_->basis.cast<float>();
   } else {
     spatial_ = std::make_unique<SpatialSolver>(mesh_, options_);

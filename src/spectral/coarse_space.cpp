@@ -49,54 +49,111 @@ double bump(double t) {
   return t >= 1.0 ? 0.0 : std::exp(-4.0 * t * t) - std::exp(-4.0);
 }
 
+// Farthest-point sampling: each next seed is the vertex farthest from all seeds so far, a vertex
+// of a component no seed reaches yet first. Each vertex belongs to the cell of its nearest seed;
+// each cell keeps its farthest vertex, recomputed (over the cell's member list, pruned of those a
+// newer seed took) only when a new seed took some of its vertices, and a lazy max-heap over the
+// cells yields the next seed: O(n) besides the pruned Dijkstras, no heap entry per vertex.
+// Returns the seeds; `nearest` gets every vertex's distance to its nearest seed.
+std::vector<int> farthest_points(const Sparse& lengths, int samples, std::vector<double>& nearest) {
+  const int n = static_cast<int>(lengths.rows());
+  nearest.assign(n, kInfinity);
+  std::vector<int> owner(n, -1), seeds;
+  std::vector<std::vector<int>> members;
+  std::vector<Entry> farthest_of;  // per cell: (distance, vertex) of its farthest member
+  std::priority_queue<std::pair<double, int>> cells;  // (distance, cell), lazy
+  std::vector<int> dirty;
+  std::vector<char> is_dirty;
+  MinHeap heap;
+  int unreached = 0;  // all vertices before it have an owner
+  while (static_cast<int>(seeds.size()) < samples) {
+    while (unreached < n && owner[unreached] >= 0) ++unreached;
+    int seed = unreached;
+    if (seed == n) {  // every vertex reached: the farthest one of the farthest cell
+      while (!cells.empty()) {
+        const auto [d, c] = cells.top();
+        if (d == farthest_of[c].first) break;
+        cells.pop();
+      }
+      if (cells.empty() || cells.top().first == 0.0) break;  // every vertex is a seed
+      seed = farthest_of[cells.top().second].second;
+    }
+    const int cell = static_cast<int>(seeds.size());
+    seeds.push_back(seed);
+    members.emplace_back();
+    farthest_of.emplace_back(0.0, seed);
+    is_dirty.push_back(0);
+    pruned_dijkstra(lengths, seed, kInfinity, nearest, heap, [&](int i, double d) {
+      if (owner[i] >= 0 && !is_dirty[owner[i]]) {
+        is_dirty[owner[i]] = 1;
+        dirty.push_back(owner[i]);
+      }
+      owner[i] = cell;
+      members[cell].push_back(i);
+      if (d > farthest_of[cell].first) farthest_of[cell] = {d, i};
+    });
+    cells.emplace(farthest_of[cell].first, cell);
+    for (const int c : dirty) {
+      std::vector<int>& list = members[c];
+      std::erase_if(list, [&](int i) { return owner[i] != c; });
+      farthest_of[c] = {0.0, seeds[c]};
+      for (const int i : list)
+        if (nearest[i] > farthest_of[c].first) farthest_of[c] = {nearest[i], i};
+      cells.emplace(farthest_of[c].first, c);
+      is_dirty[c] = 0;
+    }
+    dirty.clear();
+  }
+  return seeds;
+}
+
 }  // namespace
 
 CoarseSpace partition_of_unity(const Sparse& lengths, int samples, double support) {
   const int n = static_cast<int>(lengths.rows());
-  samples = std::clamp(samples, 1, n);
-  // Farthest-point sampling: the next seed is the vertex farthest from all seeds so far (a
-  // lazy max-heap of the distances; unreached components come first, at infinity).
-  std::vector<double> nearest(n, kInfinity);
-  std::priority_queue<Entry> farthest;
-  for (int i = n; i-- > 0;) farthest.emplace(kInfinity, i);
-  std::vector<int> seeds;
-  MinHeap heap;
-  while (static_cast<int>(seeds.size()) < samples && !farthest.empty()) {
-    const auto [d, i] = farthest.top();
-    farthest.pop();
-    if (d != nearest[i] || d == 0.0) continue;  // stale, or already a seed
-    seeds.push_back(i);
-    pruned_dijkstra(lengths, i, kInfinity, nearest, heap,
-                    [&](int j, double dj) { farthest.emplace(dj, j); });
-  }
+  std::vector<double> nearest;
+  const std::vector<int> seeds = farthest_points(lengths, std::clamp(samples, 1, n), nearest);
   CoarseSpace out;
   out.radius = *std::max_element(nearest.begin(), nearest.end());
   const double rho = support * out.radius;
 
-  // Each seed's bump, by a Dijkstra limited to rho; the seeds split between two threads.
+  // Column j of P: seed j's bump, by a Dijkstra limited to rho, its rows sorted; the seeds
+  // split between two threads.
   const int N = static_cast<int>(seeds.size());
-  std::vector<Eigen::Triplet<double>> halves[2];
-  const auto bumps = [&](int begin, int end, std::vector<Eigen::Triplet<double>>& entries) {
+  std::vector<std::vector<std::pair<int, double>>> columns(N);
+  const auto bumps = [&](int begin, int end) {
     std::vector<double> distance(n, kInfinity);
-    std::vector<int> touched;
     MinHeap local;
     for (int j = begin; j < end; ++j) {
+      std::vector<std::pair<int, double>>& column = columns[j];
       pruned_dijkstra(lengths, seeds[j], rho, distance, local, [&](int i, double d) {
-        touched.push_back(i);
-        const double value = rho > 0.0 ? bump(d / rho) : 1.0;
-        if (value > 0.0) entries.emplace_back(i, j, value);
+        column.emplace_back(i, rho > 0.0 ? bump(d / rho) : 1.0);
       });
-      for (const int i : touched) distance[i] = kInfinity;
-      touched.clear();
+      for (const auto& [i, value] : column) distance[i] = kInfinity;
+      std::erase_if(column, [](const auto& entry) { return entry.second <= 0.0; });
+      std::sort(column.begin(), column.end());
     }
   };
-  run_pair([&] { bumps(0, N / 2, halves[0]); }, [&] { bumps(N / 2, N, halves[1]); });
-  halves[0].insert(halves[0].end(), halves[1].begin(), halves[1].end());
-  halves[1] = {};
-  Sparse P(n, N);
-  P.setFromTriplets(halves[0].begin(), halves[0].end());
-  const Eigen::VectorXd row_sums = P * Eigen::VectorXd::Ones(N);
-  out.prolongation = row_sums.cwiseInverse().asDiagonal() * P;
+  run_pair([&] { bumps(0, N / 2); }, [&] { bumps(N / 2, N); });
+  // Assembled in place, each entry divided by its row's sum (the partition of unity).
+  Sparse& P = out.prolongation;
+  P.resize(n, N);
+  Eigen::Index entries = 0;
+  for (const auto& column : columns) entries += static_cast<Eigen::Index>(column.size());
+  P.resizeNonZeros(entries);
+  Eigen::VectorXd row_sums = Eigen::VectorXd::Zero(n);
+  Eigen::Index k = 0;
+  for (int j = 0; j < N; ++j) {
+    P.outerIndexPtr()[j] = static_cast<int>(k);
+    for (const auto& [i, value] : columns[j]) {
+      P.innerIndexPtr()[k] = i;
+      P.valuePtr()[k++] = value;
+      row_sums[i] += value;
+    }
+    columns[j] = {};
+  }
+  P.outerIndexPtr()[N] = static_cast<int>(k);
+  for (k = 0; k < entries; ++k) P.valuePtr()[k] /= row_sums[P.innerIndexPtr()[k]];
   return out;
 }
 

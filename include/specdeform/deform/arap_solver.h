@@ -17,11 +17,15 @@
 // bending term gives the surface the stiffness against bending and necking that the membrane
 // alone lacks (a bent bar keeps its cross-sections).
 //
-// With d = H c and the cluster operator Q (3k x m; over all vertices the sparse 3k x n operator
-// with the identity for H), the covariance of cluster k is S_k = S_k(s) + Q_k c (3 x 3) and
+// In the spectral subspace, s' = s + H c, the curvatures M^-1 K s' are taken in the mixed form,
+// as their M-projection onto the span (deform/reduced_forms.h): exact for eigenvectors, and free
+// of the kinks of a basis that is not made of them (multilevel). With the cluster operator Q
+// (3k x m; over all vertices the sparse 3k x n operator with the identity for H), the
+// covariance of cluster k is S_k = S_k(s) + Q_k c (3 x 3) and
 //     E(c, R) = tr(c^T D c) - sum_k tr((R_k - I) S_k) + constraints + const,
-// D = H^T K H + b A H^T K M^-1 K H + H^T (K+ - K) H the reduced Hessian that ReducedSolver
-// factors once per selection (reduced_solver.h; Lambda + b A Lambda^2 + ... for eigenvectors):
+// D = S + b A S G S + H^T (K+ - K) H (S = H^T K H, G = H^T M H: Lambda + b A Lambda^2 + ... for
+// eigenvectors) the reduced Hessian that ReducedSolver factors once per selection
+// (reduced_solver.h):
 //  - local step: R_k maximises tr(R_k S_k) (a closed-form polar decomposition, reflections
 //    excluded): O(k m) per iteration;
 //  - the energy's gradient in c, with the rotations optimal for c, is 2 (D c - 1/2 Q^T (R - I))
@@ -92,8 +96,10 @@ class ArapSolver {
   ArapState solve(const SpatialSolver& solver, const SpatialSolver::Targets& targets,
                   ArapState start, ArapReport* report = nullptr) const;
 
-  // Spectral: H^T (K+ - K) H (m x m), what the membrane's dropped negative cotangent weights
-  // add to the reduced Hessian Lambda (zero where the mesh has none).
+  // Spectral: the reduced Hessian D (m x m) for ReducedSolver.
+  const Eigen::MatrixXd& reduced_hessian() const { return reduced_hessian_; }
+  // Spectral: H^T (K+ - K) H (m x m), D's part from the membrane's dropped negative cotangent
+  // weights (zero where the mesh has none).
   const Eigen::MatrixXd& membrane_correction() const { return membrane_correction_; }
 
   int clusters() const { return static_cast<int>(rest_.rows() / 3); }
@@ -112,7 +118,7 @@ class ArapSolver {
   // Spectral: the same applied to the basis, Q = operator_ H (3k x m), Q^T and mean_ H (k x m).
   Eigen::MatrixXd reduced_, reduced_transposed_, reduced_mean_;
   Eigen::MatrixX3d rest_;  // S(s), 3k x 3
-  Eigen::MatrixXd membrane_correction_;
+  Eigen::MatrixXd reduced_hessian_, membrane_correction_;
 };
 
 }  // namespace specdeform

@@ -3,12 +3,10 @@
 //
 // With d = H c, H the n x m manifold harmonics (H^T M H = I, mesh units), every energy of
 // deform_options.h has a reduced Hessian D (m x m), the same for x, y and z, formed from H
-// itself (M_l the lumped mass, A the surface area: unit-area scaling):
-//     linear:  D = ks H^T K H + kb A H^T K M_l^-1 K H    (ks Lambda + kb A Lambda^2 for exact
-//              eigenvectors: diagonal)
-//     ARAP:    D = H^T K H + b A H^T K M_l^-1 K H + H^T (K+ - K) H   (its global step;
-//              arap_solver.h)
-// so that it is exact for any M-orthonormal basis, eigenvectors or not (multilevel).
+// itself (S = H^T K H, the bending in the mixed form of deform/reduced_forms.h, A the surface
+// area: unit-area scaling), so that any M-orthonormal basis serves, eigenvectors or not:
+//     linear:  D = ks S + kb A S^2           (ks Lambda + kb A Lambda^2 for eigenvectors)
+//     ARAP:    D = S + b A S^2 + H^T (K+ - K) H   (its global step; arap_solver.h)
 // This solver minimises, over the coefficients c (m x 3),
 //     E(c) = tr(c^T D c) - 2 tr(c^T g) + constraints
 // for a linear term g (m x 3; zero for the linear energy). No n x n product is ever formed.
