@@ -2,12 +2,16 @@
 // WebSocket client (Boost.Beast) sends a selection, then drags the handle with a stream of
 // frame messages, and times each frame from sending it to receiving its deformed mesh.
 //
-//   bench_editor [MESH] [--seconds S] [--hz H] [--hand V] [--modes M]
+//   bench_editor [MESH] [--seconds S] [--hz H] [--hand V] [--modes M] [--eigensolver NAME]
 //
 // MESH defaults to ../shared/meshes/models/armadillo.obj (the built-in bumpy bar without it).
 // Scene: benchmark_scene() (scene.h), or with --hand V the vertices within 5% of the diagonal
-// of vertex V as the handle and the lowest 10% along y fixed. Two runs, printed as one JSON
-// object:
+// of vertex V as the handle and the lowest 10% along y fixed. No basis cache; the eigensolver
+// is the editor's default for the mesh's size unless named. Printed as one JSON object: the
+// time to open the file (read it, compute the basis, build the deformer), the selection's
+// server time, the first frame's latency, a paint stroke's time (the selection again with the
+// fixed region grown by the vertices of one more handle-sized patch, until its state comes
+// back), and two runs:
 //  - "mouse": frames sent at H per second (default 60, a mouse) for S seconds (default 4): the
 //    results per second that come back and the latency of each (median, 90th percentile);
 //  - "closed_loop": the next frame sent as soon as the previous result arrives: the most
@@ -19,6 +23,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <thread>
 
 #include <boost/asio.hpp>
@@ -78,8 +83,8 @@ net::awaitable<std::pair<uint32_t, float>> next_result(Ws& ws) {
   }
 }
 
-net::awaitable<void> run_client(uint16_t port, sd::Selection selection, Drag drag, double hz,
-                                nlohmann::ordered_json& out) {
+net::awaitable<void> run_client(uint16_t port, sd::Selection selection, std::vector<int> stroke,
+                                Drag drag, double hz, nlohmann::ordered_json& out) {
   auto ex = co_await net::this_coro::executor;
   Ws ws(ex);
   co_await beast::get_lowest_layer(ws).async_connect(
@@ -91,19 +96,29 @@ net::awaitable<void> run_client(uint16_t port, sd::Selection selection, Drag dra
   }));
   co_await ws.async_handshake(host, "/ws", net::use_awaitable);
   ws.binary(true);
+  ws.read_message_max(std::size_t{1} << 31);  // a large mesh's rest shape is one message
   sd::server::GroupSelection groups;
   groups.selection = selection;
   groups.transforms.assign(selection.handles.size(), Eigen::Affine3d::Identity());
   groups.pinned.assign(selection.handles.size(), false);
   const std::string message = sd::server::encode_selection(groups, sd::server::Tag::Selection);
+  const auto states = [&](int count) -> net::awaitable<void> {
+    while (count > 0) {
+      beast::flat_buffer buffer;
+      co_await ws.async_read(buffer, net::use_awaitable);
+      const std::string m = beast::buffers_to_string(buffer.data());
+      if (m.find("\"error\"") != std::string::npos) throw std::runtime_error(m);
+      if (!ws.got_binary() && m.find("\"state\"") != std::string::npos) --count;
+    }
+  };
+  const Clock::time_point selecting = Clock::now();
   co_await ws.async_write(net::buffer(message), net::use_awaitable);
-  for (int states = 0; states < 2;) {  // the connection's state (a hello), the selection's
-    beast::flat_buffer buffer;
-    co_await ws.async_read(buffer, net::use_awaitable);
-    const std::string m = beast::buffers_to_string(buffer.data());
-    if (m.find("\"error\"") != std::string::npos) throw std::runtime_error(m);
-    if (!ws.got_binary() && m.find("\"state\"") != std::string::npos) ++states;
-  }
+  co_await states(2);  // the connection's state (a hello), the selection's
+  out["selection_seconds"] = ms(Clock::now() - selecting) / 1e3;
+  const Clock::time_point first = Clock::now();
+  co_await ws.async_write(net::buffer(drag.frame(1)), net::use_awaitable);
+  co_await next_result(ws);
+  out["first_frame_ms"] = ms(Clock::now() - first);
 
   // A mouse: frames at a fixed rate, results read as they come.
   std::map<uint32_t, Clock::time_point> sent;
@@ -153,6 +168,16 @@ net::awaitable<void> run_client(uint16_t port, sd::Selection selection, Drag dra
   out["closed_loop"] = {{"frames", drag.frames},
                         {"updates_per_second", drag.frames / (ms(Clock::now() - loop_start) / 1e3)},
                         {"round_trip_ms_median", percentile(round_trip, 0.5)}};
+
+  // A stroke: the fixed region grows by `stroke` vertices.
+  groups.selection.fixed.insert(groups.selection.fixed.end(), stroke.begin(), stroke.end());
+  const Clock::time_point stroking = Clock::now();
+  co_await ws.async_write(
+      net::buffer(sd::server::encode_selection(groups, sd::server::Tag::Selection)),
+      net::use_awaitable);
+  co_await states(1);
+  out["stroke_seconds"] = ms(Clock::now() - stroking) / 1e3;
+  out["stroke_vertices"] = stroke.size();
   co_await ws.async_close(websocket::close_code::normal, net::use_awaitable);
 }
 
@@ -163,6 +188,7 @@ int main(int argc, char** argv) {
       std::filesystem::path(SPECDEFORM_SHARED_DIR) / "meshes/models/armadillo.obj";
   double seconds = 4, hz = 60;
   int hand = -1, modes = 100;
+  std::optional<sd::EigenSolver> eigensolver;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto value = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string("0"); };
@@ -174,10 +200,13 @@ int main(int argc, char** argv) {
       hand = std::stoi(value());
     else if (a == "--modes")
       modes = std::stoi(value());
+    else if (a == "--eigensolver")
+      eigensolver = sd::eigen_solver_from_name(value());
     else
       mesh_path = a;
   }
   try {
+    const Clock::time_point opening = Clock::now();
     const bool found = std::filesystem::exists(mesh_path);
     sd::LoadedMesh mesh = found ? sd::read_mesh(mesh_path) : sd::server::demo_mesh();
     const std::string name = found ? mesh_path.filename().string() : sd::server::kDemoName;
@@ -189,13 +218,30 @@ int main(int argc, char** argv) {
     out["modes"] = modes;
     out["handle_vertices"] = scene.selection.handles[0].size();
     out["fixed_vertices"] = scene.selection.fixed.size();
-    sd::server::EditorServer server({.port = 0, .assets = SPECDEFORM_WEB_DIST}, {.modes = modes});
+    // The stroke: the free vertices within 3% of the diagonal of the free vertex farthest from
+    // the handle.
+    std::vector<char> selected(mesh.mesh.num_vertices(), 0);
+    for (const auto& group : scene.selection.handles)
+      for (const int v : group) selected[v] = 1;
+    for (const int v : scene.selection.fixed) selected[v] = 1;
+    Eigen::VectorXd distance =
+        (mesh.mesh.V.rowwise() - mesh.mesh.V.row(scene.selection.handles[0][0])).rowwise().norm();
+    for (int v = 0; v < mesh.mesh.num_vertices(); ++v)
+      if (selected[v]) distance[v] = -1.0;
+    Eigen::Index far = 0;
+    distance.maxCoeff(&far);
+    std::vector<int> stroke =
+        sd::radius_selection(mesh.mesh, static_cast<int>(far), 0.03, 0.0, 1).handles[0];
+    std::erase_if(stroke, [&](int v) { return selected[v] != 0; });
+    sd::server::EditorServer server({.port = 0, .assets = SPECDEFORM_WEB_DIST},
+                                    {.modes = modes, .eigensolver = eigensolver});
     server.session().open(std::move(mesh), name);
+    out["open_seconds"] = ms(Clock::now() - opening) / 1e3;
     std::thread serving([&] { server.run(); });
     const Drag drag{scene.transforms[0].translation(), static_cast<int>(seconds * hz)};
     net::io_context io;
     std::exception_ptr failure;
-    net::co_spawn(io, run_client(server.port(), scene.selection, drag, hz, out),
+    net::co_spawn(io, run_client(server.port(), scene.selection, stroke, drag, hz, out),
                   [&](std::exception_ptr e) { failure = e; });
     io.run();
     server.stop();

@@ -59,6 +59,9 @@ void add_deform_command(CLI::App& app) {
     if (options.solver == DeformSolver::Spectral) {
       ManifoldHarmonicsOptions h = args->harmonics;
       h.num_modes = modes;
+      if (cmd->count("--eigensolver") == 0) {
+        h.solver = default_eigensolver(loaded.mesh.num_vertices(), h.policy);
+      }
       const Stopwatch clock;
       basis = obtain_basis(loaded.mesh, h, args->basis, &loaded_basis);
       timings["basis"] = clock.seconds();

@@ -29,6 +29,7 @@ void add_edit_command(CLI::App& app) {
     server::EditorConfig editor;
     double max_upload_mb = 256;
     bool no_cache = false;
+    EigenSolver eigensolver = EigenSolver::BlockKrylov;
     DeformArgs deform;
   };
   auto args = std::make_shared<Args>();
@@ -41,7 +42,7 @@ void add_edit_command(CLI::App& app) {
   cmd->add_option("-m,--modes", args->editor.modes, "manifold harmonics used (default 100)")
       ->check(CLI::Range(1, 5000));
   args->deform.add_to(*cmd);
-  add_eigensolver_option(*cmd, args->editor.eigensolver);
+  add_eigensolver_option(*cmd, args->eigensolver);
   cmd->add_option("--cache-dir", args->editor.cache_dir,
                   "where bases are cached (default ~/.cache/specdeform)");
   cmd->add_flag("--no-cache", args->no_cache, "neither read nor write cached bases");
@@ -53,6 +54,7 @@ void add_edit_command(CLI::App& app) {
     args->editor.options = args->deform.merged(*cmd, server::editor_deform_options());
     args->editor.options.validate();
     if (args->no_cache) args->editor.cache_dir.clear();
+    if (cmd->count("--eigensolver") > 0) args->editor.eigensolver = args->eigensolver;
     args->server.max_message_bytes = static_cast<size_t>(args->max_upload_mb * (1 << 20));
     server::EditorServer editor(args->server, args->editor);
     LoadedMesh mesh = args->mesh.empty() ? server::demo_mesh() : load_mesh(args->mesh);

@@ -551,7 +551,9 @@ PreparedBasis EditorSession::compute_basis(const TriangleMesh& mesh, int modes) 
                        {"fraction", fraction},
                        {"cancellable", true}}));
   };
-  PreparedBasis out = prepare_basis(mesh, modes, config_.eigensolver, config_.cache_dir, report);
+  const EigenSolver solver =
+      config_.eigensolver.value_or(default_eigensolver(mesh.num_vertices(), {}));
+  PreparedBasis out = prepare_basis(mesh, modes, solver, config_.cache_dir, report);
   report(1.0, "factorizing");
   return out;
 }

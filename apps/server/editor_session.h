@@ -61,10 +61,11 @@ inline DeformOptions editor_deform_options() {
 }
 
 struct EditorConfig {
-  int modes = 100;                                     // m of a newly opened mesh
-  DeformOptions options = editor_deform_options();     // solver settings of a newly opened mesh
-  std::filesystem::path cache_dir;                     // basis cache; empty: none
-  EigenSolver eigensolver = EigenSolver::BlockKrylov;  // of the bases it computes
+  int modes = 100;                                  // m of a newly opened mesh
+  DeformOptions options = editor_deform_options();  // solver settings of a newly opened mesh
+  std::filesystem::path cache_dir;                  // basis cache; empty: none
+  std::optional<EigenSolver> eigensolver;           // of the bases it computes; none: by size
+                                                    // (default_eigensolver)
 };
 
 // Thrown from a progress report after cancel(): the computation is abandoned.

@@ -90,7 +90,11 @@ void AnchoredPoisson::set_anchors(const std::vector<int>& anchors) {
     if (next[v] && !anchored_[v]) add.push_back(v);
     if (!next[v] && anchored_[v]) remove.push_back(v);
   }
-  if (!factored_ || 4 * static_cast<Eigen::Index>(add.size() + remove.size()) > K_.rows()) {
+  // A row update costs about 5 ms at 692k vertices, the whole factorisation 2 s: refactor from
+  // scratch beyond max(16, n / 2000) changes (measured, the editor's paint stroke of 1,355
+  // vertices: 6.6 s by updates).
+  const Eigen::Index changes = static_cast<Eigen::Index>(add.size() + remove.size());
+  if (!factored_ || changes > std::max<Eigen::Index>(16, K_.rows() / 2000)) {
     anchored_ = std::move(next);
     factorize();
     factored_ = true;

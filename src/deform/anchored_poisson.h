@@ -6,7 +6,9 @@
 // set changes, newly anchored
 // vertices are removed with cholmod_rowdel and released ones put back with cholmod_rowadd (a
 // rank-2 update each), so a selection change costs in proportion to its difference; a change of
-// more than a quarter of the vertices is refactored from scratch. Solves run on two threads
+// more than max(16, n / 2000) vertices is refactored from scratch (cheaper than so many
+// updates).
+// Solves run on two threads
 // (linalg/triangular_solver.h).
 #pragma once
 

@@ -285,10 +285,9 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
     const bool lumped = basis->mass == MassType::Lumped;
     const Sparse own_mass =
         lumped ? Sparse(mass.asDiagonal()) : mass_matrix(mesh, basis->mass, basis->laplacian);
-    const Eigen::MatrixXd HS = H * S;
-    const Eigen::MatrixX3d curvature = HS * (H.transpose() * (own_mass * base));
+    const Eigen::MatrixX3d curvature = H * (S * (H.transpose() * (own_mass * base)));
     const Sparse weights = curvature_weights(curvature, mass, label_, clusters.count);
-    reduced_ = stretch * H + bend * (weights * HS);
+    reduced_ = stretch * H + bend * (Eigen::MatrixXd(weights * H) * S);  // no n x m temporary
     rest_ = stretch * base + bend * (weights * curvature);
     reduced_hessian_ =
         S + 0.5 * bend * detail::reduced_bending(S, mass, H, lumped) + membrane_correction_;

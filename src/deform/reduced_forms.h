@@ -11,8 +11,8 @@
 // armadillo's hand scene (43k vertices, ARAP), the result with a multilevel basis lay 0.34% of
 // the diagonal (RMS) from the exact basis's with the bending in the fine form, 0.12% in the mixed
 // form (0.11% without bending); the linear energy 0.015% in the mixed form.
-// K U is formed a block of rows at a time on two threads: O(nnz(K) m + n m^2) work and no
-// n x m temporary.
+// K U is formed 16 columns at a time on two threads: O(nnz(K) m + n m^2) work and no n x m
+// temporary.
 #pragma once
 
 #include <Eigen/Core>

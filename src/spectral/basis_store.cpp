@@ -45,9 +45,14 @@ ObtainedBasis obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonicsOpti
                            const std::filesystem::path& cache) {
   const auto start = std::chrono::steady_clock::now();
   ObtainedBasis out;
-  out.file = !cache.empty() && std::filesystem::is_directory(cache)
-                 ? cache / basis_file_name(mesh, o)
-                 : cache;
+  out.file = cache;
+  if (!cache.empty() && std::filesystem::is_directory(cache)) {
+    out.file = cache / basis_file_name(mesh, o);
+    ManifoldHarmonicsOptions exact = o;
+    exact.solver = EigenSolver::BlockKrylov;
+    const std::filesystem::path better = cache / basis_file_name(mesh, exact);
+    if (o.solver == EigenSolver::Multilevel && std::filesystem::exists(better)) out.file = better;
+  }
   ManifoldHarmonics h;
   if (!out.file.empty() && std::filesystem::exists(out.file)) {
     if (o.progress) o.progress(0.0, "loading the basis");

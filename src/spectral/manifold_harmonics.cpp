@@ -34,6 +34,10 @@ EigenSolver eigen_solver_from_name(std::string_view name) {
                    "' (krylov, lanczos or multilevel)");
 }
 
+EigenSolver default_eigensolver(int vertices, const ManifoldHarmonicsPolicy& policy) {
+  return vertices >= policy.multilevel_from ? EigenSolver::Multilevel : EigenSolver::BlockKrylov;
+}
+
 void ManifoldHarmonicsPolicy::validate() const {
   const auto require = [](bool ok, const char* what) {
     if (!ok) throw InputError(std::string("manifold harmonics policy: ") + what);
@@ -49,9 +53,7 @@ void ManifoldHarmonicsPolicy::validate() const {
           "multilevel sample counts must be >= 1");
   require(multilevel_support > 1.0, "multilevel_support must be > 1");
   require(multilevel_reduction >= 1, "multilevel_reduction must be >= 1");
-  require(multilevel_smoothing >= 0, "multilevel_smoothing must be >= 0");
-  require(multilevel_omega > 0.0 && multilevel_omega <= 1.0, "multilevel_omega must be in (0, 1]");
-  require(multilevel_oversampling >= 0.0, "multilevel_oversampling must be >= 0");
+  require(multilevel_from >= 0, "multilevel_from must be >= 0");
 }
 
 void ManifoldHarmonicsOptions::validate() const {

@@ -1,5 +1,6 @@
 #include "editor_session.h"
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <numeric>
@@ -120,7 +121,26 @@ TEST_F(EditorSessionTest, OpenAnnouncesTheMeshAndItsBasis) {
   EXPECT_EQ(ready["settings"]["detail"], "transfer");
   EXPECT_EQ(ready["settings"]["energy"], "linear");
   EXPECT_EQ(ready["mesh_id"].get<std::string>().size(), 16u);
+  EXPECT_FALSE(ready["basis"]["approximate"]);  // 162 vertices: the exact solver by default
   EXPECT_EQ(last_text()["type"], "state");
+}
+
+// An editor asked for the multilevel basis says so, and deforms with it.
+TEST(EditorSessionMultilevel, AnnouncesAnApproximateBasis) {
+  std::vector<Json> texts;
+  EditorSession session(EditorConfig{.modes = 20, .eigensolver = EigenSolver::Multilevel},
+                        [&](bool binary, std::string data) {
+                          if (!binary) texts.push_back(Json::parse(data));
+                        });
+  LoadedMesh mesh;
+  mesh.mesh = make_icosphere(5);  // 10,242 vertices: a coarse space of 500 functions
+  mesh.info = identity_read_info(mesh.mesh);
+  session.open(std::move(mesh), "sphere.obj");
+  const auto ready = std::find_if(texts.rbegin(), texts.rend(),
+                                  [](const Json& j) { return j["type"] == "ready"; });
+  ASSERT_NE(ready, texts.rend());
+  EXPECT_TRUE((*ready)["basis"]["approximate"]);
+  EXPECT_GT((*ready)["basis"]["residual"].get<double>(), 1e-4);
 }
 
 TEST_F(EditorSessionTest, FramesMeetTheHandleTargets) {

@@ -359,7 +359,8 @@ export class Panel {
     const lastSecond = stats.drawTimes.filter((t) => now - t < 1000).length;
     const median = (v: number[]) => (v.length ? [...v].sort((a, b) => a - b)[Math.floor(v.length / 2)] : NaN);
     const rows: [string, string][] = [
-      ['basis', r ? `${r.basis.seconds.toFixed(2)} s (${r.basis.source}, m = ${r.modes})` : '–'],
+      ['basis', r ? `${r.basis.seconds.toFixed(2)} s (${r.basis.source}, m = ${r.modes}${
+        r.basis.approximate ? `, approximate: multilevel, residual ${r.basis.residual.toPrecision(2)}` : ''})` : '–'],
       ['selection', s.server ? `${(1000 * s.server.selection_seconds).toFixed(1)} ms` : '–'],
       ['solve (server)', f ? `${f.ms.total.toFixed(1)} ms` : '–'],
       ['· reduced / inverse / detail', f

@@ -53,7 +53,13 @@ export interface ReadyMessage {
   modes: number;
   pose: number;
   settings: Settings;
-  basis: { seconds: number; source: 'computed' | 'cache' | 'reused'; residual: number; warning: string };
+  basis: {
+    seconds: number;
+    source: 'computed' | 'cache' | 'reused';
+    residual: number;
+    approximate: boolean; // multilevel: M-orthonormal, not eigenvectors (the residual says how far)
+    warning: string;
+  };
   setup: { reduced_system: number; detail_factorization: number; selection: number };
   arap_clusters: number;
 }

@@ -6,9 +6,9 @@
 // "0123456789abcdef-m100-lumped.sdbasis" or "...-m100-lumped-multilevel.sdbasis" (the names the
 // editor and the Python module have always used for the defaults). A file serves a request when
 // it was computed for this mesh and these operators and holds at least m pairs (the first m are
-// taken). An exact basis serves any request; an approximate (multilevel) one only a multilevel
-// request: a folder keeps the two apart by name, a named file holding the wrong kind is an
-// InputError rather than being overwritten.
+// taken). An exact basis serves any request (a folder's exact file is taken for a multilevel
+// request too); an approximate (multilevel) one only a multilevel request: a folder keeps the two
+// apart by name, a named file holding the wrong kind is an InputError rather than overwritten.
 #pragma once
 
 #include <filesystem>
