@@ -27,6 +27,7 @@ export class Panel {
     s.subscribe(() => this.render());
     ui.onToolChange = () => this.render();
     this.bind();
+    this.renderFields();
     setInterval(() => {
       this.renderTimings();
       this.renderMeasures();
@@ -178,8 +179,10 @@ export class Panel {
 
   private async openFile(f: File, tag: P.FileTag, what: string, confirm: string | null): Promise<void> {
     if (confirm && !(await this.confirmDiscard(confirm))) return;
-    this.s.note(`sending ${f.name} (${(f.size / 1e6).toFixed(1)} MB)…`, 'info', true);
-    this.s.request(P.encodeFile(tag, f.name, await f.arrayBuffer()), `${what} ${f.name}`, 'state');
+    // Shown while the request is on (busy), gone with its answer.
+    if (this.s.request(P.encodeFile(tag, f.name, await f.arrayBuffer()), `${what} ${f.name}`, 'state')) {
+      this.s.note(`sending ${f.name} (${(f.size / 1e6).toFixed(1)} MB)…`, 'info', true);
+    }
   }
 
   private undo(redo: boolean): void {
@@ -310,7 +313,7 @@ export class Panel {
     const active = s.groups[s.activeGroup];
     select.style.color = `#${(active?.pinned ? PIN_HEX : GROUP_HEX[s.activeGroup % GROUP_HEX.length]).toString(16).padStart(6, '0')}`;
     $('radius-value').textContent = `${$<HTMLInputElement>('radius').value}% of the diagonal`;
-    if (phase.kind !== this.lastPhase && phase.kind !== 'busy' && phase.kind !== 'disconnected') this.renderFields();
+    if (phase.kind !== this.lastPhase && (phase.kind === 'ready' || phase.kind === 'empty')) this.renderFields();
     if (phase.kind !== 'busy') this.transientToasts.splice(0).forEach((t) => t.remove());
     this.lastPhase = phase.kind;
     if (!connected || !editable) s.viewer.gizmo.detach();
@@ -329,7 +332,7 @@ export class Panel {
 
   // Fields show the server's values (after every "ready", and after a rejected change).
   private renderFields(): void {
-    const r = this.s.phase.kind === 'ready' ? this.s.ready : null;
+    const r = this.s.ready;
     if (!r) {
       // Nothing known yet: placeholders, not a default that looks like a setting.
       for (const id of ['modes', 'energy', 'ks', 'kb', 'detail', 'constraints']) $<HTMLInputElement>(id).value = '';
