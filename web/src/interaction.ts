@@ -3,6 +3,7 @@
 // orbiting only on the right button or with Alt, and the selection's shortcuts.
 import * as THREE from 'three';
 import { Brush } from './brush';
+import { Mirror, mirror, mirrored } from './mirror';
 import { EditorState, FIXED, FREE } from './state';
 import { Mode, ModalTransform } from './transform';
 
@@ -37,6 +38,9 @@ export class Interaction {
   pivotMode: PivotMode = 'median';
   cursor: THREE.Vector3 | null = null; // the 3D cursor
   private topology: { indices: Uint32Array; brush: Brush } | null = null;
+  xMirror = false; // paint both sides of the middle x plane; a group's counterpart moves mirrored
+  private symmetry: { rest: Float32Array; mirror: Mirror } | null = null;
+  private partner = new Map<number, number>(); // handle group -> its mirror image's group
 
   constructor(private readonly s: EditorState, private readonly view: HTMLElement) {
     const v = s.viewer;
@@ -187,14 +191,15 @@ export class Interaction {
       if (stroke) {
         const labels = this.s.labels;
         const changed: number[] = [];
-        for (const v of vertices) {
+        const paired = this.xMirror && stroke.pin === null ? this.mirrored(vertices, stroke.label) : [];
+        for (const [v, label] of [...Array.from(vertices, (v) => [v, stroke.label]), ...paired]) {
           // A pin stroke claims free, fixed and handle vertices; other tools leave pins alone
           // except Erase.
           const l = labels[v];
           const isPin = l >= 2 && this.s.groups[l - 2]?.pinned;
-          if (isPin && stroke.label !== FREE && l !== stroke.label) continue;
-          if (l !== stroke.label) {
-            labels[v] = stroke.label;
+          if (isPin && label !== FREE && l !== label) continue;
+          if (l !== label) {
+            labels[v] = label;
             changed.push(v);
             stroke.touched.add(v);
           }
@@ -253,7 +258,39 @@ export class Interaction {
 
   // ------------------------------------------------------------ dragging
 
+  // The counterparts of painted vertices with their label: a handle's go to the group that
+  // mirrors it (made on first use).
+  private mirrored(vertices: Uint32Array, label: number): [number, number][] {
+    const s = this.s;
+    if (this.symmetry?.rest !== s.rest) this.symmetry = { rest: s.rest, mirror: mirror(s.rest, s.ready?.diagonal ?? 1) };
+    const m = this.symmetry.mirror;
+    let target = label;
+    if (label >= 2) {
+      const g = label - 2;
+      let p = this.partner.get(g);
+      if (p === undefined || !s.groups[p] || s.groups[p].pinned) {
+        s.groups.push({ transform: mirrored(s.groups[g].transform, m), pinned: false });
+        p = s.groups.length - 1;
+        this.partner.set(g, p);
+        this.partner.set(p, g);
+      }
+      target = 2 + p;
+    }
+    const out: [number, number][] = [];
+    for (const v of vertices) if (m.of[v] >= 0 && m.of[v] !== v) out.push([m.of[v], target]);
+    return out;
+  }
+
+  // The mirrored group follows its counterpart's transform.
+  private followMirror(g: number): void {
+    const p = this.partner.get(g);
+    if (this.xMirror && p !== undefined && this.s.groups[p] && this.symmetry) {
+      this.s.groups[p].transform = mirrored(this.s.groups[g].transform, this.symmetry.mirror);
+    }
+  }
+
   private dragged(): void {
+    if (this.drag) this.followMirror(this.drag.group);
     const preview = this.s.previewWanted;
     this.usedPreview ||= preview;
     this.s.sendFrame(preview);
@@ -292,6 +329,7 @@ export class Interaction {
       this.s.viewer.orbit.enabled = true;
     }
     if (!keep) this.s.groups[d.group].transform = d.transform;
+    this.followMirror(d.group);
     if (this.usedPreview || !keep) this.s.sendFrame(false);
     if (keep) this.s.commit();
     this.placeGizmo();

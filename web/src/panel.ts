@@ -135,6 +135,7 @@ export class Panel {
     });
     $('select-linked').addEventListener('click', () =>
       s.note('point at the piece and press L (the button cannot know where you point)'));
+    $('x-mirror').addEventListener('change', (e) => (this.ui.xMirror = (e.target as HTMLInputElement).checked));
     $('select-invert').addEventListener('click', () => this.ui.selectTopology('invert'));
     $('select-grow').addEventListener('click', () => this.ui.selectTopology('grow'));
     $('select-shrink').addEventListener('click', () => this.ui.selectTopology('shrink'));
