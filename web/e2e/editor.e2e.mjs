@@ -10,6 +10,10 @@
 //    the detail method;
 //  - reload the page: the selection, transforms, deformation and undo come back;
 //  - restart the server: the page reconnects by itself and gives the new server its edit back;
+//  - Blender's modal transforms with typed values: G X d, R Z 90 and S X 1.5 give exactly that
+//    transform about the handle's centroid (the server's result follows it), Esc and a
+//    right-click cancel; the area, volume and stretch readouts; the numpad's views; select
+//    linked, invert, grow and shrink;
 //  - open another mesh, confirming that the edit is discarded.
 //
 //   node e2e/editor.e2e.mjs [--mesh FILE] [--seconds S] [--out DIR] [--quick] [--min-ratio R]
@@ -344,6 +348,7 @@ try {
     const banner = await page.$eval('#banner', (b) => { const r = b.getBoundingClientRect(); return { text: b.textContent, top: r.top }; });
     check(/Disconnected/.test(banner.text) && banner.top >= 0, `a banner says the page is disconnected (${banner.text})`);
     check(await page.$eval('#export-mesh', (b) => b.disabled), 'Export is disabled while disconnected');
+    check(await page.$eval('#gizmo-rotate', (b) => b.disabled), 'the transform tools are disabled while disconnected');
     editor = startEditor(args.binary, meshArgs, port);
     await editor.url;
     await page.waitForSelector('#banner', { state: 'hidden', timeout: 60000 });
@@ -358,6 +363,8 @@ try {
     const notes = await api(() => window.specdeformEditor.notes().map((n) => n.text));
     check(notes.some((n) => /restarted/.test(n)), `the page says the server restarted (${JSON.stringify(notes)})`);
 
+    await transformsAndSelection();
+
     // Another mesh through the file picker: the edit is discarded only once confirmed.
     log('open another mesh');
     const sphere = resolve(args.out, 'sphere.off');
@@ -370,6 +377,177 @@ try {
     await page.click('#confirm-yes');
     await page.waitForFunction(() => document.querySelector('#mesh-name').textContent.startsWith('sphere.off: 162 vertices'),
       null, { timeout: 60000 });
+    const shown = await page.$$eval('#notes .note', (els) => els.map((e) => e.textContent));
+    check(!shown.some((t) => /sending/.test(t)), `the "sending" note is gone once the mesh is open (${JSON.stringify(shown)})`);
+  }
+
+  // Typed modal transforms (exact, about the handle's centroid, the result following), cancel,
+  // the readouts, the views, and selection by topology. Ends with the handle as the drag left it.
+  async function transformsAndSelection() {
+    log('modal transforms');
+    const canvas = await page.$eval('#view canvas', (c) => { const r = c.getBoundingClientRect(); return { x: r.left + r.width / 2, y: r.top + r.height / 2 }; });
+    await page.mouse.move(canvas.x, canvas.y);
+    await page.evaluate(() => document.activeElement?.blur());
+    const keys = async (...sequence) => {
+      for (const k of sequence) await page.keyboard.press(k);
+    };
+    const transform = () => api(() => window.specdeformEditor.transforms()[0]);
+    const result = async () => {
+      await waitReady(60000);
+      return api(() => {
+        const e = window.specdeformEditor;
+        return { rest: e.restPositions(), now: e.positions(), labels: e.labels(), t: e.transforms()[0], diagonal: e.diagonal(),
+          measures: e.measures() };
+      });
+    };
+    // The handle's vertices reach the transform's targets, as near as soft constraints bring them
+    // (m = 50: a move of a fifth of the diagonal within 1e-2 of it, a scale of 1.5 within 2e-2;
+    // hard constraints need more modes than constrained vertices).
+    const followed = (r) => {
+      let worst = 0;
+      r.labels.forEach((l, v) => {
+        if (l !== 2) return;
+        const p = [0, 1, 2].map((k) => r.rest[3 * v + k]);
+        const want = [0, 1, 2].map((i) => r.t[4 * i] * p[0] + r.t[4 * i + 1] * p[1] + r.t[4 * i + 2] * p[2] + r.t[4 * i + 3]);
+        worst = Math.max(worst, Math.hypot(...want.map((w, k) => w - r.now[3 * v + k])) / r.diagonal);
+      });
+      return worst;
+    };
+    const reset = async () => {
+      await page.click('#reset');
+      await page.evaluate(() => document.activeElement?.blur());
+      await waitReady(60000);
+    };
+    const centroid = (r) => {
+      const c = [0, 0, 0];
+      let n = 0;
+      r.labels.forEach((l, v) => l === 2 && (++n, [0, 1, 2].forEach((k) => (c[k] += r.rest[3 * v + k]))));
+      return c.map((x) => x / n);
+    };
+    await reset();
+    await page.keyboard.press('4');
+    const step = Number((0.2 * state.diagonal).toPrecision(1));
+    await keys('g', 'x', ...String(step));
+    check(/Move D: .* \[.*\|\] along global X/.test(await page.textContent('#header')), `the header reads the move (${await page.textContent('#header')})`);
+    await keys('Enter');
+    let r = await result();
+    check(JSON.stringify(r.t) === JSON.stringify([1, 0, 0, step, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]), `G X ${step} is exactly that translation (${r.t})`);
+    check(followed(r) < 1e-2, `the handle followed G X (${followed(r)})`);
+    check(await page.$eval('#header', (h) => h.hidden), 'the header goes once confirmed');
+
+    const moved = r.t;
+    await keys('g', 'y', '5');
+    check((await transform())[7] === 5, 'G Y 5 moves while typed');
+    await keys('Escape');
+    check(JSON.stringify(await transform()) === JSON.stringify(moved), 'Esc cancels the move');
+    await keys('r', 'x', '4', '5');
+    await page.mouse.click(canvas.x, canvas.y, { button: 'right' });
+    check(JSON.stringify(await transform()) === JSON.stringify(moved), 'a right-click cancels the turn');
+    await waitReady(60000);
+
+    await reset();
+    await keys('r', 'z', '9', '0', 'Enter');
+    r = await result();
+    const c = centroid(r);
+    const t = r.t;
+    check(t[0] === 0 && t[1] === -1 && t[4] === 1 && t[5] === 0 && t[10] === 1, `R Z 90 is exactly a quarter turn about z (${t})`);
+    const image = [0, 1, 2].map((i) => t[4 * i] * c[0] + t[4 * i + 1] * c[1] + t[4 * i + 2] * c[2] + t[4 * i + 3]);
+    check(Math.hypot(...image.map((x, k) => x - c[k])) < 1e-9 * r.diagonal, `about the handle's centroid (${c} goes to ${image})`);
+    // The turn is about the handle's own centre: its centroid stays, within what the soft
+    // constraints give for a patch turned on its side (1% of the diagonal on the bar, 2% on the
+    // armadillo; about the gizmo's old centre, beside the handle, it moved by a third).
+    const shown = [0, 1, 2].map((k) => {
+      let sum = 0, n = 0;
+      r.labels.forEach((l, v) => l === 2 && (++n, (sum += r.now[3 * v + k])));
+      return sum / n;
+    });
+    const stays = Math.hypot(...shown.map((x, k) => x - c[k])) / r.diagonal;
+    const extent = (p) => Math.max(...[0, 1, 2].map((k) => {
+      let lo = Infinity, hi = -Infinity;
+      for (let i = k; i < p.length; i += 3) [lo, hi] = [Math.min(lo, p[i]), Math.max(hi, p[i])];
+      return hi - lo;
+    }));
+    const length = extent(r.now) / extent(r.rest);
+    log('R Z 90: handle error', followed(r), 'centroid moved', stays, 'length ratio', length, JSON.stringify(r.measures));
+    check(stays < 5e-2, `the handle's centroid stays where it was (${stays} of the diagonal)`);
+    check(r.measures && Math.abs(r.measures.area) < 0.1, `the area changes by less than 10% (${JSON.stringify(r.measures)})`);
+    const readout = await page.textContent('#measures');
+    check(/area change[+-]\d/.test(readout) && /largest edge stretch/.test(readout), `the panel reads the result's area (${readout})`);
+
+    await reset();
+    await keys('s', 'x', '1', '.', '5', 'Enter');
+    r = await result();
+    check(r.t[0] === 1.5 && r.t[5] === 1 && r.t[10] === 1 && Math.abs(r.t[3] + 0.5 * centroid(r)[0]) < 1e-12 * r.diagonal,
+      `S X 1.5 scales x by 1.5 about the centroid (${r.t})`);
+    check(followed(r) < 2e-2, `the handle followed S X 1.5 (${followed(r)})`);
+
+    log('views');
+    const looking = () => api(() => {
+      const [p, q] = [window.specdeformEditor.cameraPosition(), window.specdeformEditor.cameraTarget()];
+      const d = p.map((x, k) => x - q[k]);
+      return d.map((x) => x / Math.hypot(...d));
+    });
+    await keys('Numpad7');
+    check((await looking())[1] > 0.999, 'numpad 7 looks from the top');
+    await keys('Control+Numpad1');
+    check((await looking())[2] < -0.999, 'Ctrl + numpad 1 looks from the back');
+    await keys('Numpad1');
+    check((await looking())[2] > 0.999, 'numpad 1 looks from the front');
+
+    log('select linked, invert, grow, shrink');
+    const undoTwice = async () => {
+      for (let i = 0; i < 2; ++i) {
+        await keys('Control+z');
+        await waitReady(60000); // a busy page ignores the next
+      }
+    };
+    const count = async (label) => (await api(() => window.specdeformEditor.labels())).filter((l) => l === label).length;
+    const handles0 = await count(2);
+    await keys('1');
+    await keys('Control+Equal');
+    await waitReady(60000);
+    const grown = await count(2);
+    check(grown > handles0, `grow adds a ring (${handles0} to ${grown})`);
+    await keys('Control+Minus');
+    await waitReady(60000);
+    check((await count(2)) < grown, 'shrink takes one off');
+    await undoTwice();
+    check((await count(2)) === handles0, 'undo returns to the painted handle');
+    await keys('2');
+    const middle = await screen(ends.fixed);
+    await page.mouse.move(middle.x, middle.y);
+    await keys('l');
+    await waitReady(60000);
+    const linked = await count(1);
+    check(linked > fixed.length, `L selects the piece under the pointer (${linked} fixed vertices)`);
+    await keys('Control+i');
+    await waitReady(60000);
+    check((await count(1)) === 0 || (await count(1)) < linked, 'invert swaps fixed and free');
+    await undoTwice();
+    check((await count(1)) === fixed.length, 'undo puts the fixed region back');
+    await reset();
+
+    log('X mirror');
+    await page.click('#clear');
+    await page.check('#x-mirror');
+    await page.evaluate(() => document.activeElement?.blur());
+    await keys('1');
+    await click(ends.handle);
+    r = await result();
+    const side = (label) => r.labels.flatMap((l, v) => (l === label ? [v] : []));
+    const [left, right] = [side(2), side(3)];
+    const xs = r.rest.filter((_, i) => i % 3 === 0);
+    const plane = (Math.min(...xs) + Math.max(...xs)) / 2;
+    const key = (v, flip) => [flip ? 2 * plane - r.rest[3 * v] : r.rest[3 * v], r.rest[3 * v + 1], r.rest[3 * v + 2]].map((x) => Math.round(x / (1e-3 * r.diagonal))).join();
+    const images = new Set(right.map((v) => key(v, false)));
+    check(left.length > 0 && right.length === left.length && left.every((v) => images.has(key(v, true))),
+      `mirror painting paints the other side of the middle x plane (${left.length} and ${right.length} vertices)`);
+    await keys('g', 'x', ...String(step), 'Enter');
+    r = await result();
+    const other = await api(() => window.specdeformEditor.transforms()[1]);
+    check(other.every((x, i) => Math.abs(x - [1, 0, 0, -step, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1][i]) < 1e-12 * r.diagonal),
+      `the mirrored group moves by the mirrored G X ${step} (${other})`);
+    await page.uncheck('#x-mirror');
   }
   check(pageErrors.length === 0, `no page errors: ${pageErrors.join('; ')}`);
 } catch (e) {

@@ -1,6 +1,7 @@
 // Brush selection: the vertices within a radius of a point on the surface, measured in space
 // (Euclidean) or along the mesh's edges (geodesic, Dijkstra over the edge graph, so the brush
-// does not jump across a thin gap to another part of the shape). Typed arrays throughout, and
+// does not jump across a thin gap to another part of the shape); and by the edges alone: a
+// connected piece, a ring around a region. Typed arrays throughout, and
 // per-query work proportional to the region found, not to the mesh.
 export class Brush {
   private readonly offsets: Int32Array; // CSR adjacency of the edge graph
@@ -73,6 +74,41 @@ export class Brush {
       settled[v] = 0;
     }
     return Uint32Array.from(done);
+  }
+
+  // The vertices connected to `start` by edges: its piece of the mesh.
+  linked(start: number): Uint32Array {
+    const { offsets, neighbours } = this;
+    const seen = new Uint8Array(offsets.length - 1);
+    const out = [start];
+    seen[start] = 1;
+    for (let i = 0; i < out.length; ++i) {
+      for (let k = offsets[out[i]]; k < offsets[out[i] + 1]; ++k) {
+        const w = neighbours[k];
+        if (!seen[w]) {
+          seen[w] = 1;
+          out.push(w);
+        }
+      }
+    }
+    return Uint32Array.from(out);
+  }
+
+  // The ring around a region: `grow`, the vertices outside it with a neighbour inside;
+  // otherwise, the vertices inside with a neighbour outside.
+  ring(inside: (v: number) => boolean, grow: boolean): number[] {
+    const { offsets, neighbours } = this;
+    const out: number[] = [];
+    for (let v = 0; v + 1 < offsets.length; ++v) {
+      if (inside(v) === grow) continue;
+      for (let k = offsets[v]; k < offsets[v + 1]; ++k) {
+        if (inside(neighbours[k]) !== inside(v)) {
+          out.push(v);
+          break;
+        }
+      }
+    }
+    return out;
   }
 }
 

@@ -1,7 +1,9 @@
 // Off the main thread: the positions of every frame from its 16-bit displacements, their
-// vertex normals (of the full mesh and of the coarse preview), and the brush (the vertices within a radius, along the surface or in space), so that
+// vertex normals (of the full mesh and of the coarse preview), the full frames' area, volume
+// and stretch against the input (measures.ts), and the brush (the vertices within a radius, along the surface or in space), so that
 // the page keeps taking pointer events while a large mesh is processed.
 import { Brush } from './brush';
+import { Measures, MeshMeasures } from './measures';
 import { vertexNormals } from './normals';
 
 export type Slot = 'full' | 'preview';
@@ -12,13 +14,14 @@ export type WorkerRequest =
   | { kind: 'brush'; id: number; vertex: number; center: [number, number, number]; radius: number; geodesic: boolean };
 
 export type WorkerReply =
-  | { kind: 'frame'; slot: Slot; seq: number; positions: Float32Array; normals: Float32Array }
+  | { kind: 'frame'; slot: Slot; seq: number; positions: Float32Array; normals: Float32Array; measures: Measures | null }
   | { kind: 'brush'; id: number; vertices: Uint32Array };
 
 interface Mesh {
   indices: Uint32Array;
   rest: Float32Array;
   brush: Brush | null;
+  measures: MeshMeasures | null;
   positions: Float32Array; // the last frame's (the brush measures on them)
 }
 
@@ -33,6 +36,7 @@ self.onmessage = (e: MessageEvent<WorkerRequest>) => {
       indices: m.indices,
       rest: m.rest,
       brush: m.slot === 'full' ? new Brush(m.rest.length / 3, m.indices) : null,
+      measures: m.slot === 'full' ? new MeshMeasures(m.indices, m.rest) : null,
       positions: m.rest.slice(),
     };
   } else if (m.kind === 'frame') {
@@ -44,7 +48,8 @@ self.onmessage = (e: MessageEvent<WorkerRequest>) => {
     const normals = new Float32Array(positions.length);
     vertexNormals(positions, mesh.indices, normals);
     const copy = positions.slice();
-    post({ kind: 'frame', slot: m.slot, seq: m.seq, positions: copy, normals }, [copy.buffer, normals.buffer]);
+    const measures = mesh.measures?.of(positions) ?? null;
+    post({ kind: 'frame', slot: m.slot, seq: m.seq, positions: copy, normals, measures }, [copy.buffer, normals.buffer]);
   } else {
     const mesh = meshes.full;
     if (!mesh?.brush) return;

@@ -1,9 +1,16 @@
-// The pointer and the keyboard: painting with the brush, dragging handles (the mouse or the
-// gizmo), orbiting only on the right button or with Alt, and the shortcuts.
+// The pointer and the keyboard: painting with the brush, dragging handles (the mouse, the
+// gizmo at the pivot, or Blender's modal G / R / S), the 3D cursor (Shift + right-click),
+// orbiting only on the right button or with Alt, and the selection's shortcuts.
 import * as THREE from 'three';
+import { Brush } from './brush';
+import { Mirror, mirror, mirrored } from './mirror';
 import { EditorState, FIXED, FREE } from './state';
+import { Mode, ModalTransform } from './transform';
 
-export type Tool = 'handle' | 'fixed' | 'pin' | 'erase' | 'move';
+export type Tool = 'handle' | 'fixed' | 'erase' | 'move' | 'pin';
+// Rotations and scales turn about the active group's centroid (Blender's median point) or the
+// 3D cursor.
+export type PivotMode = 'median' | 'cursor';
 
 // How long the pointer rests before the full detail is asked for in place of the preview (ms).
 const kRestMs = 200;
@@ -13,6 +20,7 @@ interface Drag {
   start: THREE.Vector3; // the handle point grabbed (mouse) or the gizmo's start
   transform: THREE.Matrix4; // the group's at the start
   pivot?: THREE.Matrix4; // the gizmo's at the start
+  modal?: ModalTransform; // G, R or S from the keyboard
 }
 
 export class Interaction {
@@ -25,14 +33,22 @@ export class Interaction {
   private restTimer: number | undefined;
   private usedPreview = false;
   private hoverQueued: { x: number; y: number } | null = null;
+  private pointer = { x: 0, y: 0 }; // the last position over the view
+  private cursorPress: { x: number; y: number } | null = null; // a Shift + right press
+  pivotMode: PivotMode = 'median';
+  cursor: THREE.Vector3 | null = null; // the 3D cursor
+  private topology: { indices: Uint32Array; brush: Brush } | null = null;
+  xMirror = false; // paint both sides of the middle x plane; a group's counterpart moves mirrored
+  private symmetry: { rest: Float32Array; mirror: Mirror } | null = null;
+  private partner = new Map<number, number>(); // handle group -> its mirror image's group
 
   constructor(private readonly s: EditorState, private readonly view: HTMLElement) {
     const v = s.viewer;
     // Capture phase: decides before the orbit controls what a press does.
     view.addEventListener('pointerdown', (e) => this.down(e), true);
     view.addEventListener('pointermove', (e) => this.move(e));
-    view.addEventListener('pointerup', () => this.up());
-    view.addEventListener('pointercancel', () => this.up());
+    view.addEventListener('pointerup', (e) => this.up(e));
+    view.addEventListener('pointercancel', (e) => this.up(e));
     view.addEventListener('pointerleave', () => v.showBrush(null, 0));
     v.gizmo.addEventListener('dragging-changed', (e) => {
       if (e.value) this.beginGizmo();
@@ -53,7 +69,7 @@ export class Interaction {
   setTool(t: Tool): void {
     this.tool = t;
     if (t !== 'move') this.s.viewer.gizmo.detach();
-    this.placeGizmo();
+    this.placeGizmo(t === 'move');
     this.s.viewer.showBrush(null, 0);
     this.onToolChange();
   }
@@ -62,6 +78,15 @@ export class Interaction {
 
   private down(e: PointerEvent): void {
     const v = this.s.viewer;
+    if (this.drag?.modal) {
+      // A modal transform: the left button confirms, the others cancel; nothing orbits.
+      e.stopPropagation();
+      e.preventDefault();
+      this.endDrag(e.button === 0);
+      if (e.button !== 0) this.s.note('transform cancelled');
+      return;
+    }
+    if (e.button === 2 && e.shiftKey) this.cursorPress = { x: e.clientX, y: e.clientY };
     // Only presses on the model's canvas: not on what lies over it (messages, dialogs).
     if (e.button !== 0 || e.target !== v.canvas) return; // right: orbit, middle: pan
     v.orbit.mouseButtons.LEFT = e.altKey ? THREE.MOUSE.ROTATE : null;
@@ -76,7 +101,9 @@ export class Interaction {
     if (this.tool === 'move') {
       const l = hit ? this.s.labels[hit.vertex] : FREE;
       if (!hit || l < 2 || this.s.groups[l - 2].pinned) {
-        this.s.note(hit ? 'press on a coloured handle to drag it, or use the gizmo' : 'missed the model: press on a handle');
+        this.s.note(hit ? 'press on a coloured handle to drag it, or use the gizmo'
+          : this.nearGizmo(e.clientX, e.clientY) ? 'missed the gizmo: press on one of its arrows, rings or boxes (or use G, R, S)'
+            : 'missed the model: press on a handle');
         return;
       }
       this.s.activeGroup = l - 2;
@@ -107,6 +134,8 @@ export class Interaction {
 
   private move(e: PointerEvent): void {
     const v = this.s.viewer;
+    this.pointer = { x: e.clientX, y: e.clientY };
+    if (this.drag?.modal) return this.modalMoved();
     if (this.stroke) return this.paintAt(e.clientX, e.clientY);
     if (this.drag && !this.drag.pivot) {
       const p = v.onViewPlane(e.clientX, e.clientY, this.drag.start);
@@ -119,7 +148,11 @@ export class Interaction {
     if (this.tool !== 'move' && e.buttons === 0) this.hover(e.clientX, e.clientY);
   }
 
-  private up(): void {
+  private up(e: PointerEvent): void {
+    const press = this.cursorPress;
+    this.cursorPress = null;
+    if (press && e.button === 2 && Math.hypot(e.clientX - press.x, e.clientY - press.y) < 5) this.placeCursor(e.clientX, e.clientY);
+    if (this.drag?.modal) return;
     this.s.viewer.orbit.enabled = true;
     this.s.viewer.orbit.mouseButtons.LEFT = null;
     if (this.stroke) this.endStroke(true);
@@ -158,14 +191,15 @@ export class Interaction {
       if (stroke) {
         const labels = this.s.labels;
         const changed: number[] = [];
-        for (const v of vertices) {
+        const paired = this.xMirror && stroke.pin === null ? this.mirrored(vertices, stroke.label) : [];
+        for (const [v, label] of [...Array.from(vertices, (v) => [v, stroke.label]), ...paired]) {
           // A pin stroke claims free, fixed and handle vertices; other tools leave pins alone
           // except Erase.
           const l = labels[v];
           const isPin = l >= 2 && this.s.groups[l - 2]?.pinned;
-          if (isPin && stroke.label !== FREE && l !== stroke.label) continue;
-          if (l !== stroke.label) {
-            labels[v] = stroke.label;
+          if (isPin && label !== FREE && l !== label) continue;
+          if (l !== label) {
+            labels[v] = label;
             changed.push(v);
             stroke.touched.add(v);
           }
@@ -224,7 +258,39 @@ export class Interaction {
 
   // ------------------------------------------------------------ dragging
 
+  // The counterparts of painted vertices with their label: a handle's go to the group that
+  // mirrors it (made on first use).
+  private mirrored(vertices: Uint32Array, label: number): [number, number][] {
+    const s = this.s;
+    if (this.symmetry?.rest !== s.rest) this.symmetry = { rest: s.rest, mirror: mirror(s.rest, s.ready?.diagonal ?? 1) };
+    const m = this.symmetry.mirror;
+    let target = label;
+    if (label >= 2) {
+      const g = label - 2;
+      let p = this.partner.get(g);
+      if (p === undefined || !s.groups[p] || s.groups[p].pinned) {
+        s.groups.push({ transform: mirrored(s.groups[g].transform, m), pinned: false });
+        p = s.groups.length - 1;
+        this.partner.set(g, p);
+        this.partner.set(p, g);
+      }
+      target = 2 + p;
+    }
+    const out: [number, number][] = [];
+    for (const v of vertices) if (m.of[v] >= 0 && m.of[v] !== v) out.push([m.of[v], target]);
+    return out;
+  }
+
+  // The mirrored group follows its counterpart's transform.
+  private followMirror(g: number): void {
+    const p = this.partner.get(g);
+    if (this.xMirror && p !== undefined && this.s.groups[p] && this.symmetry) {
+      this.s.groups[p].transform = mirrored(this.s.groups[g].transform, this.symmetry.mirror);
+    }
+  }
+
   private dragged(): void {
+    if (this.drag) this.followMirror(this.drag.group);
     const preview = this.s.previewWanted;
     this.usedPreview ||= preview;
     this.s.sendFrame(preview);
@@ -258,65 +324,208 @@ export class Interaction {
     if (!d) return;
     this.drag = null;
     clearTimeout(this.restTimer);
+    if (d.modal) {
+      this.showHeader('');
+      this.s.viewer.orbit.enabled = true;
+    }
     if (!keep) this.s.groups[d.group].transform = d.transform;
+    this.followMirror(d.group);
     if (this.usedPreview || !keep) this.s.sendFrame(false);
     if (keep) this.s.commit();
     this.placeGizmo();
     this.s.changed();
   }
 
-  // The gizmo sits beside the active group (off its surface, so that the handle stays
-  // visible and grabbable), moved with the group's transform.
-  placeGizmo(): void {
-    const v = this.s.viewer;
-    const g = this.s.activeGroup;
-    const group = this.s.groups[g];
-    if (this.tool !== 'move' || !group || group.pinned || !this.s.editable) {
-      v.gizmo.detach();
-      v.requestRender();
-      return;
-    }
+  // The active group's centroid at rest (null if it has no vertices).
+  private restCentroid(g: number): THREE.Vector3 | null {
     const rest = this.s.rest;
-    const centroid = new THREE.Vector3();
+    const c = new THREE.Vector3();
     let count = 0;
     this.s.labels.forEach((l, k) => {
       if (l !== 2 + g) return;
-      centroid.x += rest[3 * k];
-      centroid.y += rest[3 * k + 1];
-      centroid.z += rest[3 * k + 2];
+      c.x += rest[3 * k];
+      c.y += rest[3 * k + 1];
+      c.z += rest[3 * k + 2];
       ++count;
     });
-    if (count === 0) {
+    return count > 0 ? c.divideScalar(count) : null;
+  }
+
+  // Where the active group turns and scales about: its centroid where its transform takes it,
+  // or the 3D cursor.
+  pivotPoint(): THREE.Vector3 | null {
+    const g = this.s.activeGroup;
+    const c = this.restCentroid(g);
+    if (!c) return null;
+    return this.pivotMode === 'cursor' && this.cursor ? this.cursor.clone() : c.applyMatrix4(this.s.groups[g].transform);
+  }
+
+  // The gizmo sits at the pivot (the Move tool, a movable active group); `reveal`: the view pans
+  // if the pivot is out of view or under the messages.
+  placeGizmo(reveal = false): void {
+    const v = this.s.viewer;
+    const group = this.s.groups[this.s.activeGroup];
+    const at = this.tool === 'move' && group && !group.pinned && this.s.editable && !this.drag?.modal ? this.pivotPoint() : null;
+    if (!at) {
       v.gizmo.detach();
       v.requestRender();
       return;
     }
-    centroid.divideScalar(count);
-    let radius = 0;
-    this.s.labels.forEach((l, k) => {
-      if (l === 2 + g) radius = Math.max(radius, centroid.distanceTo(new THREE.Vector3().fromArray(rest, 3 * k)));
-    });
-    // Beside the group, away from the model's centre as seen from the camera, by the group's
-    // size plus the gizmo's reach (TransformControls scales itself with the distance to the
-    // camera: its arrows reach about 0.1 of it).
-    const at = centroid.clone().applyMatrix4(group.transform);
-    const view = v.camera.getWorldDirection(new THREE.Vector3());
-    const away = at.clone().sub(v.orbit.target).projectOnPlane(view);
-    if (away.lengthSq() < 1e-12 * at.lengthSq() + 1e-30) away.setFromMatrixColumn(v.camera.matrixWorld, 0);
-    at.add(away.normalize().multiplyScalar(radius + 0.15 * at.distanceTo(v.camera.position)));
     if (this.drag?.pivot) return; // the gizmo moves itself while dragged
     v.pivot.position.copy(at);
     v.pivot.quaternion.identity();
     v.pivot.scale.set(1, 1, 1);
     v.pivot.updateMatrix();
     v.gizmo.attach(v.pivot);
+    if (reveal) v.keepInView(at, this.clearArea());
     v.requestRender();
+  }
+
+  // The part of the view that no overlay covers, less the gizmo's reach.
+  private clearArea(): DOMRect {
+    const r = this.s.viewer.canvas.getBoundingClientRect();
+    const overlay = document.getElementById('overlay')!.getBoundingClientRect();
+    const top = Math.max(r.top, overlay.bottom) + 90;
+    return new DOMRect(r.left + 110, top, Math.max(0, r.width - 220), Math.max(0, r.bottom - 120 - top));
+  }
+
+  private nearGizmo(x: number, y: number): boolean {
+    const v = this.s.viewer;
+    if (!v.gizmo.object) return false;
+    const c = v.toScreen(v.pivot.position);
+    return Math.hypot(x - c.x, y - c.y) < 140;
+  }
+
+  // Shift + right-click on the surface: the 3D cursor goes there.
+  private placeCursor(x: number, y: number): void {
+    const hit = this.s.viewer.pick(x, y);
+    if (!hit) return this.s.note('missed the model: the 3D cursor goes on the surface');
+    this.cursor = hit.point;
+    this.s.viewer.showCursor(hit.point);
+    this.placeGizmo();
+  }
+
+  // ------------------------------------------------------------ modal transforms
+
+  // G, R or S: the active group follows the pointer (or a typed value) until confirmed.
+  startModal(mode: Mode): void {
+    const s = this.s;
+    const g = s.activeGroup;
+    const group = s.groups[g];
+    const pivot = this.pivotPoint();
+    if (!s.editable || this.stroke || this.drag || !group || group.pinned || !pivot) {
+      if (s.editable && !this.stroke && !this.drag) s.note('paint a handle first: G, R and S move the active handle group');
+      return;
+    }
+    const diagonal = s.ready?.diagonal ?? 1;
+    const step = 10 ** Math.floor(Math.log10(diagonal / 20)); // Ctrl snaps a move to this
+    const modal = new ModalTransform(mode, pivot, group.transform.clone(), { ...this.pointer }, s.viewer, step);
+    this.drag = { group: g, start: pivot, transform: group.transform.clone(), modal };
+    this.usedPreview = false;
+    s.viewer.gizmo.detach();
+    s.viewer.orbit.enabled = false;
+    this.modalMoved();
+  }
+
+  // A key during a modal transform; returns whether it was one of its keys.
+  modalKey(e: KeyboardEvent): boolean {
+    const modal = this.drag?.modal;
+    if (!modal) return false;
+    const axis = ['KeyX', 'KeyY', 'KeyZ'].indexOf(e.code);
+    if (e.key === 'Enter' || e.key === 'NumpadEnter') this.endDrag(true);
+    else if (e.key === 'Escape') {
+      this.endDrag(false);
+      this.s.note('transform cancelled');
+    } else if (axis >= 0) modal.setAxis(axis, e.shiftKey);
+    else if (e.key === 'Control') modal.snap = true;
+    else if (!modal.type(e.key)) return false;
+    if (this.drag?.modal) this.modalMoved();
+    return true;
+  }
+
+  modalKeyUp(e: KeyboardEvent): void {
+    const modal = this.drag?.modal;
+    if (modal && e.key === 'Control') {
+      modal.snap = false;
+      this.modalMoved();
+    }
+  }
+
+  private modalMoved(): void {
+    const d = this.drag!;
+    this.s.groups[d.group].transform = d.modal!.matrix(this.pointer);
+    this.showHeader(d.modal!.readout(this.pointer));
+    this.dragged();
+  }
+
+  private showHeader(text: string): void {
+    const header = document.getElementById('header')!;
+    header.textContent = text;
+    header.hidden = text === '';
+  }
+
+  // ------------------------------------------------------------ selection by topology
+
+  private get graph(): Brush {
+    if (this.topology?.indices !== this.s.indices) {
+      this.topology = { indices: this.s.indices, brush: new Brush(this.s.labels.length, this.s.indices) };
+    }
+    return this.topology.brush;
+  }
+
+  // The label the current tool paints (null for Pin: pins are painted stroke by stroke).
+  private toolLabel(): number | null {
+    if (this.tool === 'pin') return null;
+    if (this.tool === 'fixed') return FIXED;
+    if (this.tool === 'erase') return FREE;
+    if (this.s.groups[this.s.activeGroup].pinned) this.s.activeGroup = this.newGroup(false);
+    return 2 + this.s.activeGroup;
+  }
+
+  // L: the piece under the pointer; invert: the tool's label and the free vertices swap;
+  // grow / shrink: by one ring of neighbours. One undo step each.
+  selectTopology(op: 'linked' | 'invert' | 'grow' | 'shrink'): void {
+    const s = this.s;
+    if (!s.editable || this.stroke || this.drag) return;
+    const label = this.toolLabel();
+    if (label === null) return s.note('Pin paints one pinned region per stroke: pick Handle, Fixed or Erase');
+    const labels = s.labels;
+    const isPin = (l: number) => l >= 2 && s.groups[l - 2]?.pinned;
+    let targets: number[];
+    if (op === 'linked') {
+      const hit = s.viewer.pick(this.pointer.x, this.pointer.y);
+      if (!hit) return s.note('missed the model: L selects the piece under the pointer');
+      targets = Array.from(this.graph.linked(hit.vertex), (v) => v);
+    } else if (op === 'invert') {
+      if (label === FREE) return s.note('invert swaps the tool\'s label with the free vertices: pick Handle or Fixed');
+      targets = [];
+      labels.forEach((l, v) => (l === label || l === FREE) && targets.push(v));
+    } else {
+      const inside = (v: number) => labels[v] === label;
+      targets = this.graph.ring(inside, op === 'grow');
+    }
+    const changed: number[] = [];
+    for (const v of targets) {
+      const l = labels[v];
+      if (isPin(l) && label !== FREE) continue;
+      const next = op === 'invert' ? (l === label ? FREE : label) : op === 'shrink' ? FREE : label;
+      if (l !== next) {
+        labels[v] = next;
+        changed.push(v);
+      }
+    }
+    if (changed.length === 0) return s.note('nothing changed');
+    s.paint(changed);
+    s.sendSelection();
+    this.placeGizmo();
+    s.changed();
   }
 
   // ------------------------------------------------------------ keyboard
 
   // Escape: cancels a drag or a stroke; returns whether there was one.
   cancel(): boolean {
+    if (this.drag?.modal) return this.modalKey(new KeyboardEvent('keydown', { key: 'Escape' }));
     if (this.drag) {
       const gizmo = this.drag.pivot !== undefined;
       this.endDrag(false);
@@ -332,7 +541,7 @@ export class Interaction {
     return false;
   }
 
-  // F: the active group (or the selection, or the whole mesh) fills the view.
+  // F: the active group (or the selection, or the whole mesh) in the middle of the view.
   frameSelection(): void {
     const p = this.s.viewer.positions();
     const points: THREE.Vector3[] = [];

@@ -34,6 +34,8 @@ const viewer = state.viewer;
   previewSize: () => (state.previewWanted ? viewer.previewSize : 0),
   notes: () => state.notes.map((n) => ({ ...n })),
   cameraPosition: () => viewer.camera.position.toArray(),
+  cameraTarget: () => viewer.orbit.target.toArray(),
+  measures: () => state.measures,
   setView: (direction: [number, number, number], zoom = 1) => {
     const target = viewer.orbit.target;
     const distance = viewer.camera.position.distanceTo(target) / zoom;

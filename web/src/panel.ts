@@ -2,8 +2,10 @@
 // (errors stay until dismissed) and their log, the disconnected banner, progress with Cancel,
 // and the confirmation before a mesh replaces unsaved work. Everything shown follows from the
 // state (render()); the controls send requests through it.
-import { Interaction, Tool } from './interaction';
+import { Interaction, PivotMode, Tool } from './interaction';
+import * as THREE from 'three';
 import * as P from './protocol';
+import type { Mode } from './transform';
 import { EditorState, GROUP_HEX, PIN_HEX, stats } from './state';
 
 const $ = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
@@ -13,18 +15,23 @@ const HINTS: Record<Tool, string> = {
   fixed: 'Fixed: paint what must stay at its rest position.',
   pin: 'Pin: paint what must stay where it is shown now (each stroke is one pin).',
   erase: 'Erase: paint to clear handles, fixed vertices and pins.',
-  move: 'Move: drag a coloured handle, or the gizmo beside it (T translate, R rotate); Esc cancels.',
+  move: 'Move: drag a coloured handle or the gizmo at the pivot, or press G, R or S (then X/Y/Z, a value, Enter); Esc cancels.',
 };
 
 export class Panel {
   private shownNotes = 0; // notes already turned into toasts
   private lastPhase = '';
+  private transientToasts: HTMLElement[] = []; // removed when the request ends
 
   constructor(private readonly s: EditorState, private readonly ui: Interaction) {
     s.subscribe(() => this.render());
     ui.onToolChange = () => this.render();
     this.bind();
-    setInterval(() => this.renderTimings(), 500);
+    this.renderFields();
+    setInterval(() => {
+      this.renderTimings();
+      this.renderMeasures();
+    }, 500);
     setInterval(() => this.renderBanner(), 250);
   }
 
@@ -107,7 +114,7 @@ export class Panel {
     }
     $('group').addEventListener('change', (e) => {
       s.activeGroup = Number((e.target as HTMLSelectElement).value);
-      this.ui.placeGizmo();
+      this.ui.placeGizmo(true);
       this.render();
     });
     $('new-group').addEventListener('click', () => {
@@ -115,8 +122,23 @@ export class Panel {
       this.ui.setTool('handle');
     });
     $('radius').addEventListener('input', () => this.render());
-    $('gizmo-translate').addEventListener('click', () => s.viewer.gizmo.setMode('translate'));
-    $('gizmo-rotate').addEventListener('click', () => s.viewer.gizmo.setMode('rotate'));
+    for (const mode of ['translate', 'rotate', 'scale'] as const) {
+      $(`gizmo-${mode}`).addEventListener('click', () => {
+        s.viewer.gizmo.setMode(mode);
+        this.ui.setTool('move');
+      });
+    }
+    $('pivot').addEventListener('change', (e) => {
+      this.ui.pivotMode = (e.target as HTMLSelectElement).value as PivotMode;
+      if (this.ui.pivotMode === 'cursor' && !this.ui.cursor) s.note('Shift+right-click on the surface places the 3D cursor');
+      this.ui.placeGizmo();
+    });
+    $('select-linked').addEventListener('click', () =>
+      s.note('point at the piece and press L (the button cannot know where you point)'));
+    $('x-mirror').addEventListener('change', (e) => (this.ui.xMirror = (e.target as HTMLInputElement).checked));
+    $('select-invert').addEventListener('click', () => this.ui.selectTopology('invert'));
+    $('select-grow').addEventListener('click', () => this.ui.selectTopology('grow'));
+    $('select-shrink').addEventListener('click', () => this.ui.selectTopology('shrink'));
     $('clear').addEventListener('click', () => {
       s.labels.fill(0);
       s.groups = [{ transform: s.groups[0].transform.identity(), pinned: false }];
@@ -139,6 +161,7 @@ export class Panel {
     $('export-scene').addEventListener('click', () => s.request({ type: 'export_scene' }, 'export scene', 'file'));
 
     window.addEventListener('keydown', (e) => this.key(e));
+    window.addEventListener('keyup', (e) => this.ui.modalKeyUp(e));
     window.addEventListener('dragover', (e) => {
       e.preventDefault();
       document.body.classList.add('drop');
@@ -157,8 +180,10 @@ export class Panel {
 
   private async openFile(f: File, tag: P.FileTag, what: string, confirm: string | null): Promise<void> {
     if (confirm && !(await this.confirmDiscard(confirm))) return;
-    this.s.note(`sending ${f.name} (${(f.size / 1e6).toFixed(1)} MB)…`);
-    this.s.request(P.encodeFile(tag, f.name, await f.arrayBuffer()), `${what} ${f.name}`, 'state');
+    // Shown while the request is on (busy), gone with its answer.
+    if (this.s.request(P.encodeFile(tag, f.name, await f.arrayBuffer()), `${what} ${f.name}`, 'state')) {
+      this.s.note(`sending ${f.name} (${(f.size / 1e6).toFixed(1)} MB)…`, 'info', true);
+    }
   }
 
   private undo(redo: boolean): void {
@@ -168,28 +193,48 @@ export class Panel {
     s.request({ type: redo ? 'redo' : 'undo' }, redo ? 'redo' : 'undo', 'state');
   }
 
+  // The key map (docs/editor.md): digits pick tools, the numeric keypad's 1, 3, 7 (Ctrl: the
+  // opposite side) look along the axes, as in Blender.
   private key(e: KeyboardEvent): void {
     const target = e.target as HTMLElement;
     if (target instanceof HTMLInputElement || target instanceof HTMLSelectElement || target instanceof HTMLTextAreaElement) return;
     if ($<HTMLDialogElement>('confirm').open) return;
+    if (this.ui.modalKey(e)) return e.preventDefault();
     const key = e.key.toLowerCase();
     const s = this.s;
-    if ((e.ctrlKey || e.metaKey) && key === 'z') {
+    const ctrl = e.ctrlKey || e.metaKey;
+    const views: Record<string, [number, number, number]> = { Numpad1: [0, 0, 1], Numpad3: [1, 0, 0], Numpad7: [0, 1, 0] };
+    const tools: Record<string, Tool> = { Digit1: 'handle', Digit2: 'fixed', Digit3: 'erase', Digit4: 'move', Digit5: 'pin' };
+    if (views[e.code]) {
+      e.preventDefault();
+      s.viewer.lookFrom(new THREE.Vector3(...views[e.code]).multiplyScalar(ctrl ? -1 : 1));
+    } else if (e.code === 'NumpadDecimal') {
+      this.ui.frameSelection();
+    } else if (ctrl && key === 'z') {
       e.preventDefault();
       this.undo(e.shiftKey);
-    } else if ((e.ctrlKey || e.metaKey) && key === 'y') {
+    } else if (ctrl && key === 'y') {
       e.preventDefault();
       this.undo(true);
+    } else if (ctrl && key === 'i') {
+      e.preventDefault();
+      this.ui.selectTopology('invert');
+    } else if (ctrl && (e.code === 'NumpadAdd' || e.code === 'Equal')) {
+      e.preventDefault();
+      this.ui.selectTopology('grow');
+    } else if (ctrl && (e.code === 'NumpadSubtract' || e.code === 'Minus')) {
+      e.preventDefault();
+      this.ui.selectTopology('shrink');
     } else if (e.key === 'Escape') {
       this.ui.cancel();
     } else if (e.key === 'Home') {
-      s.viewer.resetCamera();
-    } else if (!e.ctrlKey && !e.metaKey && !e.altKey) {
-      const tools: Record<string, Tool> = { '1': 'handle', '2': 'fixed', '3': 'erase', '4': 'move', '5': 'pin' };
-      if (tools[key]) this.ui.setTool(tools[key]);
+      s.viewer.frame();
+    } else if (!ctrl && !e.altKey) {
+      const modes: Record<string, Mode> = { g: 'grab', r: 'rotate', s: 'scale' };
+      if (tools[e.code]) this.ui.setTool(tools[e.code]);
+      else if (modes[key]) this.ui.startModal(modes[key]);
       else if (key === 'n') $('new-group').click();
-      else if (key === 't') s.viewer.gizmo.setMode('translate');
-      else if (key === 'r') s.viewer.gizmo.setMode('rotate');
+      else if (key === 'l') this.ui.selectTopology('linked');
       else if (key === 'f') this.ui.frameSelection();
     }
   }
@@ -243,7 +288,8 @@ export class Panel {
       : phase.kind === 'empty' ? 'no mesh open' : phase.kind === 'loading' ? 'preparing the mesh…' : 'connecting…';
     const enable = (id: string, on: boolean) => ($<HTMLButtonElement>(id).disabled = !on);
     for (const id of ['undo', 'redo', 'reset', 'apply-pose', 'export-mesh', 'export-scene', 'clear', 'new-group',
-      'energy', 'ks', 'kb', 'detail', 'constraints', 'modes', 'show-base', 'group', 'export-format']) {
+      'energy', 'ks', 'kb', 'detail', 'constraints', 'modes', 'show-base', 'group', 'export-format', 'gizmo-translate',
+      'gizmo-rotate', 'gizmo-scale', 'pivot', 'select-linked', 'select-invert', 'select-grow', 'select-shrink']) {
       enable(id, editable);
     }
     enable('open-demo', connected && phase.kind !== 'loading' && phase.kind !== 'busy');
@@ -269,6 +315,7 @@ export class Panel {
     select.style.color = `#${(active?.pinned ? PIN_HEX : GROUP_HEX[s.activeGroup % GROUP_HEX.length]).toString(16).padStart(6, '0')}`;
     $('radius-value').textContent = `${$<HTMLInputElement>('radius').value}% of the diagonal`;
     if (phase.kind !== this.lastPhase && (phase.kind === 'ready' || phase.kind === 'empty')) this.renderFields();
+    if (phase.kind !== 'busy') this.transientToasts.splice(0).forEach((t) => t.remove());
     this.lastPhase = phase.kind;
     if (!connected || !editable) s.viewer.gizmo.detach();
     else if (this.ui.tool === 'move' && !s.viewer.gizmo.object) this.ui.placeGizmo();
@@ -287,7 +334,12 @@ export class Panel {
   // Fields show the server's values (after every "ready", and after a rejected change).
   private renderFields(): void {
     const r = this.s.ready;
-    if (!r) return;
+    if (!r) {
+      // Nothing known yet: placeholders, not a default that looks like a setting.
+      for (const id of ['modes', 'energy', 'ks', 'kb', 'detail', 'constraints']) $<HTMLInputElement>(id).value = '';
+      $<HTMLInputElement>('show-base').checked = false;
+      return this.renderModes();
+    }
     $<HTMLInputElement>('modes').value = String(r.modes);
     $<HTMLSelectElement>('energy').value = r.settings.energy;
     $<HTMLInputElement>('ks').value = String(r.settings.ks);
@@ -330,7 +382,8 @@ export class Panel {
       el.append(text, close);
       notes.append(el);
       // Information fades; errors stay until dismissed.
-      if (note.level === 'info') setTimeout(() => el.remove(), 6000);
+      if (note.transient) this.transientToasts.push(el);
+      else if (note.level === 'info') setTimeout(() => el.remove(), 6000);
       while (notes.children.length > 4) notes.firstElementChild!.remove();
       const li = document.createElement('li');
       li.className = note.level;
@@ -349,6 +402,23 @@ export class Panel {
     const wait = phase.retryAt === null ? null : Math.max(0, Math.ceil((phase.retryAt - performance.now()) / 1000));
     $('banner-text').textContent = `Disconnected: ${phase.reason}. ` +
       (wait === null ? 'Edits are paused.' : `Reconnecting in ${wait} s; edits are paused.`);
+  }
+
+  // The result against the input: area, volume (closed meshes), the largest stretch.
+  private renderMeasures(): void {
+    const m = this.s.editable ? this.s.measures : null;
+    const percent = (x: number) => `${x >= 0 ? '+' : ''}${(100 * x).toFixed(1)}%`;
+    const rows: [string, string][] = [
+      ['area change', m ? percent(m.area) : '–'],
+      ['volume change', m ? (m.volume === null ? 'open surface: no volume' : percent(m.volume)) : '–'],
+      ['largest edge stretch', m ? percent(m.stretch) : '–'],
+    ];
+    $('measures').replaceChildren(...rows.map(([k, v]) => {
+      const tr = document.createElement('tr');
+      tr.append(Object.assign(document.createElement('td'), { textContent: k }),
+        Object.assign(document.createElement('td'), { textContent: v }));
+      return tr;
+    }));
   }
 
   private renderTimings(): void {

@@ -4,6 +4,7 @@
 import * as THREE from 'three';
 import { Connection, ConnectionStatus } from './connection';
 import type { Slot, WorkerReply, WorkerRequest } from './geometry.worker';
+import type { Measures } from './measures';
 import * as P from './protocol';
 import { Viewer } from './viewer';
 
@@ -24,7 +25,8 @@ export interface Group {
   pinned: boolean;
 }
 
-export type Note = { text: string; level: 'info' | 'error'; time: number };
+// `transient`: true while it holds (a file being sent), gone when the request ends.
+export type Note = { text: string; level: 'info' | 'error'; time: number; transient: boolean };
 
 // Drawing and response statistics (the timings panel and the end-to-end test).
 export const stats = {
@@ -52,6 +54,7 @@ export class EditorState {
   groups: Group[] = [{ transform: new THREE.Matrix4(), pinned: false }];
   activeGroup = 0;
   frame: P.FrameResult | null = null; // the last one received
+  measures: Measures | null = null; // of the full frame shown
   notes: Note[] = [];
   drawMs = 0; // the full mesh's draw time
   previewWanted = false;
@@ -99,9 +102,11 @@ export class EditorState {
   }
 
   // Messages for the user: errors stay until dismissed (panel.ts), the last 30 are kept.
-  note(text: string, level: Note['level'] = 'info'): void {
+  note(text: string, level: Note['level'] = 'info', transient = false): void {
     if (!text) return;
-    this.notes.push({ text, level, time: Date.now() });
+    // Bytes of a garbage file quoted by the server's reader show as one '?' per run.
+    text = text.replace(/[\u0000-\u0008\u000b-\u001f\u007f-\u009f\ufffd]+/g, '?');
+    this.notes.push({ text, level, time: Date.now(), transient });
     if (this.notes.length > 30) this.notes.shift();
     this.changed();
   }
@@ -303,7 +308,10 @@ export class EditorState {
     }
     this.normalsBusy[m.slot] = false;
     const newer = m.slot === 'full' || !this.fullAfter(m.seq);
-    if (m.slot === 'full') this.viewer.setPositions(m.positions, m.normals);
+    if (m.slot === 'full') {
+      this.viewer.setPositions(m.positions, m.normals);
+      this.measures = m.measures;
+    }
     else if (newer) this.viewer.showPreview(m.positions, m.normals);
     this.pendingDraw = Math.max(this.pendingDraw ?? 0, m.seq);
     const queued = this.normalsQueued[m.slot];

@@ -1,7 +1,8 @@
 // The three.js view: the shaded mesh (smooth normals, per-vertex selection colours, optional
 // wireframe), a coarse preview mesh drawn instead during drags of large meshes, orbit / pan /
-// zoom on the right and middle buttons (or Alt + left), a translate / rotate gizmo beside the
-// active handle group, the brush's circle, and picking with a BVH (three-mesh-bvh).
+// zoom on the right and middle buttons (or Alt + left; the wheel zooms towards the pointer),
+// view presets and an axis widget, a translate / rotate / scale gizmo at the pivot, the 3D
+// cursor, the brush's circle, and picking with a BVH (three-mesh-bvh).
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TransformControls } from 'three/addons/controls/TransformControls.js';
@@ -28,6 +29,9 @@ export class Viewer {
   private readonly coarseGeometry = new THREE.BufferGeometry();
   private readonly coarse: THREE.Mesh;
   private readonly ring: THREE.LineLoop;
+  private readonly cursorMark: THREE.LineSegments;
+  private readonly previewLabel: HTMLElement;
+  private readonly axes: HTMLCanvasElement; // the axis widget
   private readonly raycaster = new THREE.Raycaster();
   private bvh: MeshBVH | null = null;
   private bvhStale = false;
@@ -63,12 +67,34 @@ export class Viewer {
     this.ring = new THREE.LineLoop(circle, new THREE.LineBasicMaterial({ color: 0x1d2026, depthTest: false, transparent: true }));
     this.ring.visible = false;
     this.ring.renderOrder = 1;
-    this.scene.add(this.surface, this.coarse, this.wireframe, this.pivot, this.ring);
+    // The 3D cursor: a red and white ring with a cross, drawn over the surface.
+    const mark: THREE.Vector3[] = [];
+    for (let i = 0; i < 16; ++i) {
+      const a = (i * Math.PI) / 8, b = ((i + 1) * Math.PI) / 8;
+      mark.push(new THREE.Vector3(Math.cos(a), Math.sin(a), 0), new THREE.Vector3(Math.cos(b), Math.sin(b), 0));
+    }
+    mark.push(new THREE.Vector3(-1.6, 0, 0), new THREE.Vector3(-0.6, 0, 0), new THREE.Vector3(0.6, 0, 0), new THREE.Vector3(1.6, 0, 0),
+      new THREE.Vector3(0, -1.6, 0), new THREE.Vector3(0, -0.6, 0), new THREE.Vector3(0, 0.6, 0), new THREE.Vector3(0, 1.6, 0));
+    const markColors = mark.map((_, i) => (Math.floor(i / 2) % 2 ? [1, 1, 1] : [0.85, 0.1, 0.1])).flat();
+    const markGeometry = new THREE.BufferGeometry().setFromPoints(mark);
+    markGeometry.setAttribute('color', new THREE.Float32BufferAttribute(markColors, 3));
+    this.cursorMark = new THREE.LineSegments(markGeometry,
+      new THREE.LineBasicMaterial({ vertexColors: true, depthTest: false, transparent: true }));
+    this.cursorMark.visible = false;
+    this.cursorMark.renderOrder = 2;
+    this.scene.add(this.surface, this.coarse, this.wireframe, this.pivot, this.ring, this.cursorMark);
+    this.previewLabel = Object.assign(document.createElement('div'), {
+      id: 'preview-label', textContent: 'preview; detail on release', hidden: true });
+    this.axes = Object.assign(document.createElement('canvas'), { id: 'axes', width: 96, height: 96,
+      title: 'click an axis to look along it (numpad 1, 3, 7; Ctrl for the opposite side)' });
+    this.axes.addEventListener('click', (e) => this.axisClicked(e));
+    container.append(this.previewLabel, this.axes);
 
     this.orbit = new OrbitControls(this.camera, this.renderer.domElement);
     // The left button paints and drags; orbiting is on the right button (or Alt + left, which
     // the interaction switches on), panning on the middle one or Shift + right.
     this.orbit.mouseButtons = { LEFT: null, MIDDLE: THREE.MOUSE.PAN, RIGHT: THREE.MOUSE.ROTATE };
+    this.orbit.zoomToCursor = true;
     this.orbit.addEventListener('change', () => this.requestRender());
     this.gizmo = new TransformControls(this.camera, this.renderer.domElement);
     this.gizmo.addEventListener('change', () => this.requestRender());
@@ -126,6 +152,7 @@ export class Viewer {
     this.bvhStale = true;
     this.coarse.visible = false;
     this.surface.visible = true;
+    this.previewLabel.hidden = true;
     this.requestRender();
   }
 
@@ -179,6 +206,7 @@ export class Viewer {
     p.needsUpdate = nrm.needsUpdate = true;
     this.coarse.visible = true;
     this.surface.visible = false;
+    this.previewLabel.hidden = false;
     this.requestRender();
   }
 
@@ -215,6 +243,13 @@ export class Viewer {
     this.requestRender();
   }
 
+  // The 3D cursor's mark at `point` (sized with the view), or none.
+  showCursor(point: THREE.Vector3 | null): void {
+    this.cursorMark.visible = point !== null;
+    if (point) this.cursorMark.position.copy(point);
+    this.requestRender();
+  }
+
   pick(clientX: number, clientY: number): Hit | null {
     if (!this.bvh) return null;
     if (this.bvhStale) {
@@ -243,6 +278,12 @@ export class Viewer {
     return { x: rect.left + ((v.x + 1) / 2) * rect.width, y: rect.top + ((1 - v.y) / 2) * rect.height };
   }
 
+  // The ray from the camera through (clientX, clientY).
+  ray(clientX: number, clientY: number): THREE.Ray {
+    this.raycaster.setFromCamera(this.ndc(clientX, clientY), this.camera);
+    return this.raycaster.ray.clone();
+  }
+
   // The world point under (clientX, clientY) on the plane through `through` facing the camera.
   onViewPlane(clientX: number, clientY: number, through: THREE.Vector3): THREE.Vector3 | null {
     this.raycaster.setFromCamera(this.ndc(clientX, clientY), this.camera);
@@ -251,13 +292,40 @@ export class Viewer {
     return this.raycaster.ray.intersectPlane(plane, new THREE.Vector3());
   }
 
-  // Frames the given points (or the whole mesh) without turning the camera.
+  // Frames the given points (or the whole mesh) without turning the camera; the points' sphere
+  // fills about a third of the view, the whole mesh all of it.
   frame(points?: THREE.Vector3[]): void {
-    const sphere = points && points.length > 0
-      ? new THREE.Sphere().setFromPoints(points)
-      : this.geometry.boundingSphere ?? new THREE.Sphere();
-    sphere.radius = Math.max(sphere.radius, (this.geometry.boundingSphere?.radius ?? 1) * 0.05);
+    const whole = this.geometry.boundingSphere ?? new THREE.Sphere();
+    const sphere = points && points.length > 0 ? new THREE.Sphere().setFromPoints(points) : whole.clone();
+    if (points && points.length > 0) sphere.radius = Math.min(whole.radius, Math.max(3 * sphere.radius, 0.15 * whole.radius));
     this.frameSphere(sphere, this.camera.position.clone().sub(this.orbit.target));
+  }
+
+  // Looks at the same target from the side `direction` points to, at the same distance, the
+  // world's Y upwards (numpad 1 front, 3 right, 7 top; from above, -Z is up on screen).
+  lookFrom(direction: THREE.Vector3): void {
+    const distance = this.camera.position.distanceTo(this.orbit.target);
+    const d = direction.clone().normalize();
+    if (Math.abs(d.y) > 0.999) d.z += 1e-6; // straight down or up: the orbit's up stays Y
+    this.camera.position.copy(this.orbit.target).add(d.normalize().multiplyScalar(distance));
+    this.orbit.update();
+    this.requestRender();
+  }
+
+  // Pans (without turning) so that `point` lies in the part of the view that `clear` allows
+  // (client coordinates); returns whether it moved.
+  keepInView(point: THREE.Vector3, clear: DOMRect): boolean {
+    const s = this.toScreen(point);
+    if (s.x >= clear.left && s.x <= clear.right && s.y >= clear.top && s.y <= clear.bottom) return false;
+    const a = this.onViewPlane(s.x, s.y, point);
+    const b = this.onViewPlane(clear.left + clear.width / 2, clear.top + clear.height / 2, point);
+    if (!a || !b) return false;
+    const shift = a.sub(b);
+    this.camera.position.add(shift);
+    this.orbit.target.add(shift);
+    this.orbit.update();
+    this.requestRender();
+    return true;
   }
 
   resetCamera(): void {
@@ -305,8 +373,56 @@ export class Viewer {
     requestAnimationFrame(() => {
       this.renderQueued = false;
       this.renderer.render(this.scene, this.camera);
+      this.drawAxes();
       this.onRendered();
     });
+  }
+
+  // The axis widget: the world axes as the camera sees them, +X red, +Y green, +Z blue.
+  private axisEnds(): { axis: THREE.Vector3; x: number; y: number; depth: number; label: string; color: string }[] {
+    const inverse = this.camera.quaternion.clone().invert();
+    const names = ['X', 'Y', 'Z'];
+    const colors = ['#d43d3d', '#4e9a28', '#2b6de8'];
+    return [0, 1, 2].flatMap((k) => [1, -1].map((sign) => {
+      const axis = new THREE.Vector3().setComponent(k, sign);
+      const v = axis.clone().applyQuaternion(inverse);
+      return { axis, x: 48 + 34 * v.x, y: 48 - 34 * v.y, depth: v.z, label: sign > 0 ? names[k] : '', color: colors[k] };
+    }));
+  }
+
+  private drawAxes(): void {
+    const ctx = this.axes.getContext('2d');
+    if (!ctx) return;
+    ctx.clearRect(0, 0, 96, 96);
+    for (const e of this.axisEnds().sort((a, b) => a.depth - b.depth)) {
+      if (e.label) {
+        ctx.strokeStyle = e.color;
+        ctx.lineWidth = 2;
+        ctx.beginPath();
+        ctx.moveTo(48, 48);
+        ctx.lineTo(e.x, e.y);
+        ctx.stroke();
+      }
+      ctx.fillStyle = e.label ? e.color : `${e.color}66`;
+      ctx.beginPath();
+      ctx.arc(e.x, e.y, e.label ? 8 : 6, 0, 2 * Math.PI);
+      ctx.fill();
+      if (e.label) {
+        ctx.fillStyle = '#fff';
+        ctx.font = 'bold 10px system-ui';
+        ctx.textAlign = 'center';
+        ctx.textBaseline = 'middle';
+        ctx.fillText(e.label, e.x, e.y + 0.5);
+      }
+    }
+  }
+
+  // A click on an axis' end looks along it, from that side.
+  private axisClicked(e: MouseEvent): void {
+    const near = this.axisEnds().filter((a) => Math.hypot(a.x - e.offsetX, a.y - e.offsetY) < 10)
+      .sort((a, b) => b.depth - a.depth)[0];
+    if (!near) return;
+    this.lookFrom(near.axis);
   }
 
   private ndc(clientX: number, clientY: number): THREE.Vector2 {
