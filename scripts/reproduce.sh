@@ -2,8 +2,8 @@
 # Regenerates docs/results/: the paper's Table 1, Fig. 5 and Fig. 6 measured on this machine,
 # pictures of the pipeline (original, smooth base, deformed base, detailed result), all with the
 # paper's linear energy; the linear energy, spectral ARAP and CGAL's SR-ARAP on scenes that turn
-# (tables and pictures); and the intrinsic Delaunay Laplacian against the cotan one on every
-# shared model.
+# (tables and pictures); the intrinsic Delaunay Laplacian against the cotan one on every
+# shared model; and the exact and the multilevel basis on subdivided meshes up to 2.77M vertices.
 # Needs ../shared/meshes (the test meshes) and a build (scripts/setup.sh); installs
 # python3-matplotlib for the plot and chromium for the pictures where missing.
 # Usage: scripts/reproduce.sh [OUT]     (default: docs/results; takes about 30 minutes)
@@ -94,6 +94,16 @@ done
 echo "== The basis against scipy's eigsh (same run, medians of 5)"
 PYTHONPATH=build/python /usr/bin/python3 benchmarks/basis_vs_scipy.py "$arm" -k 100 --repeat 5 \
   --json "$out/basis_vs_scipy.json"
+
+echo "== Large meshes: the exact and the multilevel basis (about 15 minutes, 10 GB at 2.77M)"
+for level in 1 2 3; do $bin subdivide "$arm" -l $level -o "$work/armadillo-l$level.obj"; done
+for level in 1 2; do
+  $bin subdivide "$models/stanford-bunny.obj" -l $level -o "$work/bunny-l$level.obj"
+done
+ear=docs/results/scenes/bunny-ear.json
+/usr/bin/python3 scripts/scaling.py "$out/scaling" "$arm=$hand" "$work/armadillo-l1.obj=$hand" \
+  "$work/armadillo-l2.obj=$hand" "$work/bunny-l1.obj=$ear" "$work/bunny-l2.obj=$ear" \
+  "$work/armadillo-l3.obj=$hand" --lanczos-below 200000
 
 echo "== pictures"
 jobs="["
