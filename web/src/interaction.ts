@@ -82,8 +82,8 @@ export class Interaction {
       // A modal transform: the left button confirms, the others cancel; nothing orbits.
       e.stopPropagation();
       e.preventDefault();
-      this.endDrag(e.button === 0);
-      if (e.button !== 0) this.s.note('transform cancelled');
+      if (e.button === 0) this.endDrag(true);
+      else this.cancel();
       return;
     }
     if (e.button === 2 && e.shiftKey) this.cursorPress = { x: e.clientX, y: e.clientY };
@@ -433,10 +433,8 @@ export class Interaction {
     if (!modal) return false;
     const axis = ['KeyX', 'KeyY', 'KeyZ'].indexOf(e.code);
     if (e.key === 'Enter' || e.key === 'NumpadEnter') this.endDrag(true);
-    else if (e.key === 'Escape') {
-      this.endDrag(false);
-      this.s.note('transform cancelled');
-    } else if (axis >= 0) modal.setAxis(axis, e.shiftKey);
+    else if (e.key === 'Escape') this.cancel();
+    else if (axis >= 0) modal.setAxis(axis, e.shiftKey);
     else if (e.key === 'Control') modal.snap = true;
     else if (!modal.type(e.key)) return false;
     if (this.drag?.modal) this.modalMoved();
@@ -525,12 +523,12 @@ export class Interaction {
 
   // Escape: cancels a drag or a stroke; returns whether there was one.
   cancel(): boolean {
-    if (this.drag?.modal) return this.modalKey(new KeyboardEvent('keydown', { key: 'Escape' }));
     if (this.drag) {
       const gizmo = this.drag.pivot !== undefined;
+      const modal = this.drag.modal !== undefined;
       this.endDrag(false);
       if (gizmo) this.s.viewer.gizmo.detach(), this.placeGizmo();
-      this.s.note('drag cancelled');
+      this.s.note(modal ? 'transform cancelled' : 'drag cancelled');
       return true;
     }
     if (this.stroke) {
