@@ -23,6 +23,6 @@ else:
 
 
 def cache_dir():
-    """The basis cache the CLI and the editor use: $XDG_CACHE_HOME/specdeform or ~/.cache/specdeform."""
+    """The basis cache the editor uses: $XDG_CACHE_HOME/specdeform or ~/.cache/specdeform."""
     root = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     return os.path.join(root, "specdeform")

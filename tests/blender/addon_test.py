@@ -2,8 +2,9 @@
 the same mesh and selection, unbind, apply, bad groups, polygons.
 
     blender -b --factory-startup --python-exit-code 1 --python addon_test.py -- SCENE
-SCENE: generated (the built-in bumpy bar, twisted 90 degrees) or twisted-bar (the shared
-bar-twist scene; exits 77, skipped, without ../shared). Environment: SPECDEFORM_BLENDER_DIR,
+SCENE: generated (the built-in bumpy bar, twisted 90 degrees), twisted-bar (the shared
+bar-twist scene; exits 77, skipped, without ../shared) or mismatch (the compiled module cannot be
+imported: the add-on registers and says why in one line). Environment: SPECDEFORM_BLENDER_DIR,
 SPECDEFORM_PYTHON_DIR, SPECDEFORM_CLI, SPECDEFORM_SHARED_DIR.
 """
 
@@ -13,11 +14,26 @@ import subprocess
 import sys
 import tempfile
 
+SCENE = sys.argv[sys.argv.index("--") + 1]
+if SCENE == "mismatch":
+    sys.modules["specdeform"] = None  # the compiled module cannot be imported
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import support  # noqa: E402
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
+from specdeform_blender import library  # noqa: E402
+
+if SCENE == "mismatch":
+    support.fresh_file()
+    message = library.problem
+    print(message)
+    assert library.specdeform is None and "\n" not in message
+    assert message.startswith("specdeform module not loadable in Blender's Python 3.")
+    bpy.ops.mesh.primitive_cube_add()
+    assert not bpy.ops.specdeform.bind.poll()
+    sys.exit(0)
+
 import specdeform  # noqa: E402
 
 
@@ -145,14 +161,13 @@ def check_polygons():
 
 
 def main():
-    scene = sys.argv[sys.argv.index("--") + 1]
-    V, F, handle, fixed, T, min_ring = twisted_bar_scene() if scene == "twisted-bar" else generated_scene()
+    scene = twisted_bar_scene() if SCENE == "twisted-bar" else generated_scene()
     support.fresh_file()
     with tempfile.TemporaryDirectory() as workdir:
         os.environ["XDG_CACHE_HOME"] = workdir  # a fresh basis cache
-        obj = check_deform(scene, V, F, handle, fixed, T, min_ring, workdir)
+        obj = check_deform(SCENE, *scene, workdir)
         check_refusals(obj)
-        if scene == "generated":
+        if SCENE == "generated":
             check_polygons()
     print("passed")
 
