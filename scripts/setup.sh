@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what specdeform needs on Debian 12 (idempotent), then configures and builds it: the
-# C++ library, program, tests and benchmarks, the Python bindings (build/python), and the browser
-# editor (web/dist, with Vite) and the Blender add-on (build/blender; Debian's blender runs its tests).
+# C++ library, program, tests and benchmarks, the Python bindings (build/python), the Blender
+# add-on (build/blender; Debian's blender runs its tests) and the browser editor (web/dist, Vite).
 # Usage: scripts/setup.sh [build-dir]      (default: build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
