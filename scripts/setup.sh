@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what specdeform needs on Debian 12 (idempotent), then configures and builds it: the
-# C++ library, program, tests and benchmarks, the Python bindings (build/python), and the browser
-# editor (web/dist, with Vite).
+# C++ library, program, tests and benchmarks, the Python bindings (build/python), the Blender
+# add-on (build/blender; Debian's blender runs its tests) and the browser editor (web/dist, Vite).
 # Usage: scripts/setup.sh [build-dir]      (default: build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -10,7 +10,7 @@ build=${1:-build}
 packages=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libopenblas-dev
           libspectra-dev libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev libboost-dev
           libcgal-dev python3-dev pybind11-dev python3-numpy python3-scipy python3-pytest
-          python3-matplotlib)
+          python3-matplotlib blender)
 command -v npm >/dev/null || packages+=(nodejs npm)
 scripts/apt_install.sh "${packages[@]}"
 

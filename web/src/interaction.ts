@@ -3,6 +3,7 @@
 // orbiting only on the right button or with Alt, and the selection's shortcuts.
 import * as THREE from 'three';
 import { Brush } from './brush';
+import { Rect, verticesInRect } from './boxselect';
 import { Mirror, mirror, mirrored } from './mirror';
 import { EditorState, FIXED, FREE } from './state';
 import { Mode, ModalTransform } from './transform';
@@ -41,6 +42,8 @@ export class Interaction {
   xMirror = false; // paint both sides of the middle x plane; a group's counterpart moves mirrored
   private symmetry: { rest: Float32Array; mirror: Mirror } | null = null;
   private partner = new Map<number, number>(); // handle group -> its mirror image's group
+  private box: { armed: boolean; from: { x: number; y: number } | null } = { armed: false, from: null }; // B
+  xray = false; // box selection through the surface
 
   constructor(private readonly s: EditorState, private readonly view: HTMLElement) {
     const v = s.viewer;
@@ -82,11 +85,17 @@ export class Interaction {
       // A modal transform: the left button confirms, the others cancel; nothing orbits.
       e.stopPropagation();
       e.preventDefault();
-      this.endDrag(e.button === 0);
-      if (e.button !== 0) this.s.note('transform cancelled');
+      if (e.button === 0) this.endDrag(true);
+      else this.cancel();
       return;
     }
     if (e.button === 2 && e.shiftKey) this.cursorPress = { x: e.clientX, y: e.clientY };
+    if (this.box.armed && e.button === 0 && e.target === v.canvas) {
+      e.stopPropagation();
+      this.box.from = { x: e.clientX, y: e.clientY };
+      this.view.setPointerCapture(e.pointerId);
+      return;
+    }
     // Only presses on the model's canvas: not on what lies over it (messages, dialogs).
     if (e.button !== 0 || e.target !== v.canvas) return; // right: orbit, middle: pan
     v.orbit.mouseButtons.LEFT = e.altKey ? THREE.MOUSE.ROTATE : null;
@@ -136,6 +145,7 @@ export class Interaction {
     const v = this.s.viewer;
     this.pointer = { x: e.clientX, y: e.clientY };
     if (this.drag?.modal) return this.modalMoved();
+    if (this.box.from) return this.showBox(this.boxRect(this.box.from, this.pointer));
     if (this.stroke) return this.paintAt(e.clientX, e.clientY);
     if (this.drag && !this.drag.pivot) {
       const p = v.onViewPlane(e.clientX, e.clientY, this.drag.start);
@@ -153,6 +163,10 @@ export class Interaction {
     this.cursorPress = null;
     if (press && e.button === 2 && Math.hypot(e.clientX - press.x, e.clientY - press.y) < 5) this.placeCursor(e.clientX, e.clientY);
     if (this.drag?.modal) return;
+    if (this.box.from && e.button === 0) {
+      this.endBox(this.boxRect(this.box.from, { x: e.clientX, y: e.clientY }));
+      return;
+    }
     this.s.viewer.orbit.enabled = true;
     this.s.viewer.orbit.mouseButtons.LEFT = null;
     if (this.stroke) this.endStroke(true);
@@ -433,10 +447,8 @@ export class Interaction {
     if (!modal) return false;
     const axis = ['KeyX', 'KeyY', 'KeyZ'].indexOf(e.code);
     if (e.key === 'Enter' || e.key === 'NumpadEnter') this.endDrag(true);
-    else if (e.key === 'Escape') {
-      this.endDrag(false);
-      this.s.note('transform cancelled');
-    } else if (axis >= 0) modal.setAxis(axis, e.shiftKey);
+    else if (e.key === 'Escape') this.cancel();
+    else if (axis >= 0) modal.setAxis(axis, e.shiftKey);
     else if (e.key === 'Control') modal.snap = true;
     else if (!modal.type(e.key)) return false;
     if (this.drag?.modal) this.modalMoved();
@@ -473,6 +485,43 @@ export class Interaction {
     return this.topology.brush;
   }
 
+  // B: the next left drag draws a rectangle; its vertices get the tool's label.
+  armBox(): void {
+    if (!this.s.editable || this.stroke || this.drag) return;
+    this.box.armed = true;
+    this.showHeader(`Box select (${this.xray ? 'X-ray: through the surface' : 'visible vertices only'}): ` +
+      'drag a rectangle with the left button; Esc cancels');
+  }
+
+  private boxRect(a: { x: number; y: number }, b: { x: number; y: number }): Rect {
+    return { left: Math.min(a.x, b.x), top: Math.min(a.y, b.y), right: Math.max(a.x, b.x), bottom: Math.max(a.y, b.y) };
+  }
+
+  private showBox(r: Rect | null): void {
+    const box = document.getElementById('box')!;
+    box.hidden = r === null;
+    if (!r) return;
+    const view = this.view.getBoundingClientRect();
+    Object.assign(box.style, { left: `${r.left - view.left}px`, top: `${r.top - view.top}px`,
+      width: `${r.right - r.left}px`, height: `${r.bottom - r.top}px` });
+  }
+
+  // Ends the box (null: cancelled).
+  endBox(r: Rect | null): boolean {
+    if (!this.box.armed) return false;
+    this.box = { armed: false, from: null };
+    this.showBox(null);
+    this.showHeader('');
+    if (!r) return true;
+    const label = this.toolLabel();
+    if (label === null) {
+      this.s.note('Pin paints one pinned region per stroke: pick Handle, Fixed or Erase');
+      return true;
+    }
+    this.relabel(verticesInRect(this.s.viewer, r, this.xray, this.s.ready?.diagonal ?? 1), () => label, label);
+    return true;
+  }
+
   // The label the current tool paints (null for Pin: pins are painted stroke by stroke).
   private toolLabel(): number | null {
     if (this.tool === 'pin') return null;
@@ -490,7 +539,6 @@ export class Interaction {
     const label = this.toolLabel();
     if (label === null) return s.note('Pin paints one pinned region per stroke: pick Handle, Fixed or Erase');
     const labels = s.labels;
-    const isPin = (l: number) => l >= 2 && s.groups[l - 2]?.pinned;
     let targets: number[];
     if (op === 'linked') {
       const hit = s.viewer.pick(this.pointer.x, this.pointer.y);
@@ -504,13 +552,20 @@ export class Interaction {
       const inside = (v: number) => labels[v] === label;
       targets = this.graph.ring(inside, op === 'grow');
     }
+    this.relabel(targets, (l) => (op === 'invert' ? (l === label ? FREE : label) : op === 'shrink' ? FREE : label), label);
+  }
+
+  // Gives each of `targets` its new label (pins stay unless erased): one undo step.
+  private relabel(targets: number[], next: (label: number) => number, label: number): void {
+    const s = this.s;
+    const labels = s.labels;
     const changed: number[] = [];
     for (const v of targets) {
       const l = labels[v];
-      if (isPin(l) && label !== FREE) continue;
-      const next = op === 'invert' ? (l === label ? FREE : label) : op === 'shrink' ? FREE : label;
-      if (l !== next) {
-        labels[v] = next;
+      if (l >= 2 && s.groups[l - 2]?.pinned && label !== FREE) continue;
+      const to = next(l);
+      if (l !== to) {
+        labels[v] = to;
         changed.push(v);
       }
     }
@@ -525,12 +580,13 @@ export class Interaction {
 
   // Escape: cancels a drag or a stroke; returns whether there was one.
   cancel(): boolean {
-    if (this.drag?.modal) return this.modalKey(new KeyboardEvent('keydown', { key: 'Escape' }));
+    if (this.endBox(null)) return true;
     if (this.drag) {
       const gizmo = this.drag.pivot !== undefined;
+      const modal = this.drag.modal !== undefined;
       this.endDrag(false);
       if (gizmo) this.s.viewer.gizmo.detach(), this.placeGizmo();
-      this.s.note('drag cancelled');
+      this.s.note(modal ? 'transform cancelled' : 'drag cancelled');
       return true;
     }
     if (this.stroke) {

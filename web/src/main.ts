@@ -36,6 +36,7 @@ const viewer = state.viewer;
   cameraPosition: () => viewer.camera.position.toArray(),
   cameraTarget: () => viewer.orbit.target.toArray(),
   measures: () => state.measures,
+  cursor: () => interaction.cursor?.toArray() ?? null,
   setView: (direction: [number, number, number], zoom = 1) => {
     const target = viewer.orbit.target;
     const distance = viewer.camera.position.distanceTo(target) / zoom;

@@ -1,6 +1,6 @@
 // X-mirror symmetry across the plane x = c through the middle of the bounding box: each
-// vertex's counterpart (the nearest vertex to its mirror image, within a thousandth of the
-// diagonal; none where the mesh is not symmetric), and a handle group's transform mirrored for
+// vertex's counterpart (the nearest vertex to its mirror image, within 2% of the diagonal:
+// exact on symmetric meshes, near on scanned ones; none where nothing is near), and a handle group's transform mirrored for
 // its counterpart group.
 import * as THREE from 'three';
 
@@ -20,7 +20,7 @@ export function mirror(rest: Float32Array, diagonal: number): Mirror {
   let lo = Infinity, hi = -Infinity;
   for (let v = 0; v < n; ++v) [lo, hi] = [Math.min(lo, rest[3 * v]), Math.max(hi, rest[3 * v])];
   const c = (lo + hi) / 2;
-  const tolerance = 1e-3 * diagonal;
+  const tolerance = 0.02 * diagonal;
   const cell = (x: number) => Math.floor(x / tolerance);
   const key = (i: number, j: number, k: number) => `${i},${j},${k}`;
   const grid = new Map<string, number[]>();

@@ -136,6 +136,8 @@ export class Panel {
     $('select-linked').addEventListener('click', () =>
       s.note('point at the piece and press L (the button cannot know where you point)'));
     $('x-mirror').addEventListener('change', (e) => (this.ui.xMirror = (e.target as HTMLInputElement).checked));
+    $('select-box').addEventListener('click', () => this.ui.armBox());
+    $('xray').addEventListener('change', (e) => (this.ui.xray = (e.target as HTMLInputElement).checked));
     $('select-invert').addEventListener('click', () => this.ui.selectTopology('invert'));
     $('select-grow').addEventListener('click', () => this.ui.selectTopology('grow'));
     $('select-shrink').addEventListener('click', () => this.ui.selectTopology('shrink'));
@@ -225,6 +227,8 @@ export class Panel {
     } else if (ctrl && (e.code === 'NumpadSubtract' || e.code === 'Minus')) {
       e.preventDefault();
       this.ui.selectTopology('shrink');
+    } else if (e.altKey && key === 'z') {
+      $<HTMLInputElement>('xray').click();
     } else if (e.key === 'Escape') {
       this.ui.cancel();
     } else if (e.key === 'Home') {
@@ -235,6 +239,7 @@ export class Panel {
       else if (modes[key]) this.ui.startModal(modes[key]);
       else if (key === 'n') $('new-group').click();
       else if (key === 'l') this.ui.selectTopology('linked');
+      else if (key === 'b') this.ui.armBox();
       else if (key === 'f') this.ui.frameSelection();
     }
   }
@@ -289,7 +294,7 @@ export class Panel {
     const enable = (id: string, on: boolean) => ($<HTMLButtonElement>(id).disabled = !on);
     for (const id of ['undo', 'redo', 'reset', 'apply-pose', 'export-mesh', 'export-scene', 'clear', 'new-group',
       'energy', 'ks', 'kb', 'detail', 'constraints', 'modes', 'show-base', 'group', 'export-format', 'gizmo-translate',
-      'gizmo-rotate', 'gizmo-scale', 'pivot', 'select-linked', 'select-invert', 'select-grow', 'select-shrink']) {
+      'gizmo-rotate', 'gizmo-scale', 'pivot', 'select-linked', 'select-invert', 'select-grow', 'select-shrink', 'select-box', 'xray']) {
       enable(id, editable);
     }
     enable('open-demo', connected && phase.kind !== 'loading' && phase.kind !== 'busy');

@@ -1,0 +1,175 @@
+"""The add-on in Blender, headless: bind, move the target, compare with `specdeform deform` on
+the same mesh and selection, unbind, apply, bad groups, polygons.
+
+    blender -b --factory-startup --python-exit-code 1 --python addon_test.py -- SCENE
+SCENE: generated (the built-in bumpy bar, twisted 90 degrees), twisted-bar (the shared
+bar-twist scene; exits 77, skipped, without ../shared) or mismatch (the compiled module cannot be
+imported: the add-on registers and says why in one line). Environment: SPECDEFORM_BLENDER_DIR,
+SPECDEFORM_PYTHON_DIR, SPECDEFORM_CLI, SPECDEFORM_SHARED_DIR.
+"""
+
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+SCENE = sys.argv[sys.argv.index("--") + 1]
+if SCENE == "mismatch":
+    sys.modules["specdeform"] = None  # the compiled module cannot be imported
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import support  # noqa: E402
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+from specdeform_blender import library  # noqa: E402
+
+if SCENE == "mismatch":
+    support.fresh_file()
+    message = library.problem
+    print(message)
+    assert library.specdeform is None and "\n" not in message
+    assert message.startswith("specdeform module not loadable in Blender's Python 3.")
+    bpy.ops.mesh.primitive_cube_add()
+    assert not bpy.ops.specdeform.bind.poll()
+    sys.exit(0)
+
+import specdeform  # noqa: E402
+
+
+def generated_scene():
+    V, F = specdeform.bumpy_bar(cells_per_unit=12)
+    x = V[:, 0]
+    handle = np.flatnonzero(x > 3.6)
+    fixed = np.flatnonzero(x < 0.4)
+    c, s = math.cos(math.pi / 2), math.sin(math.pi / 2)
+    T = np.array([[1, 0, 0, 0.2], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1]])
+    return V, F, handle, fixed, T, 0.85  # the coarse bar at 90 degrees: 0.8996
+
+
+def twisted_bar_scene():
+    shared = support.shared_dir()
+    if shared is None:
+        print("skipped: ../shared/meshes (the twisted bar) is missing")
+        sys.exit(support.SKIP)
+    base = os.path.join(shared, "meshes", "scenes", "bar-twist")
+    s = specdeform.read_scene(base + ".sel", base + ".off", base + ".def")
+    return s.V, s.F, s.handles[0], s.fixed, s.transforms[0], 0.9
+
+
+def cli_deform(V, F, handle, fixed, T, workdir):
+    """`specdeform deform` on the mesh as Blender holds it (float32) with the same selection."""
+    mesh, sel, tdef, out = (os.path.join(workdir, f) for f in ("m.off", "m.sel", "m.def", "o.off"))
+    specdeform.write_mesh(mesh, V.astype(np.float64), F)
+    status = np.ones(len(V), int)
+    status[fixed], status[handle] = 0, 2
+    np.savetxt(sel, status, fmt="%d")
+    np.savetxt(tdef, T, header="handle", fmt="%.17g")
+    subprocess.run([os.environ["SPECDEFORM_CLI"], "deform", mesh, "--sel", sel, "--def", tdef,
+                    "-o", out], check=True, stdout=subprocess.DEVNULL)
+    return specdeform.read_mesh(out)[0]
+
+
+def bind(obj):
+    bpy.context.view_layer.objects.active = obj
+    assert bpy.ops.specdeform.bind() == {"FINISHED"}
+    assert obj.specdeform.bound
+
+
+def check_deform(name, V, F, handle, fixed, T, min_ring, workdir):
+    obj, empty = support.add_object(name, V, F, handle, fixed)
+    rest = support.evaluated(obj)
+    diagonal = support.diagonal(rest)
+    bind(obj)
+    assert np.array_equal(support.evaluated(obj), rest), "binding moved the mesh"
+    support.move(empty, T)
+    X = support.evaluated(obj)
+    cli = cli_deform(rest, F, handle, fixed, T, workdir)
+    to_cli = np.abs(X - cli).max() / diagonal
+    miss = np.linalg.norm(X[handle] - support.apply_transform(T, rest[handle]), axis=1).max()
+    ring = support.ring_ratios(rest, X).min()
+    print(f"{name}: vs CLI {to_cli:.1e}, handle miss {miss / diagonal:.2e}, ring {ring:.3f}")
+    assert to_cli <= 1e-5, to_cli
+    assert miss <= 0.005 * diagonal, miss / diagonal
+    assert ring >= min_ring, ring  # the linear energy: 0.25-0.4
+
+    # The object moved and turned with its target: the deformation is the same in local space.
+    R = np.array(support.Matrix.Rotation(0.7, 4, (1, 2, 3)))
+    R[:3, 3] = (5, -2, 1)
+    obj.matrix_world = support.Matrix(R.tolist())
+    support.move(empty, R @ T)
+    assert np.abs(support.evaluated(obj) - X).max() <= 1e-5 * diagonal
+
+    assert bpy.ops.specdeform.unbind() == {"FINISHED"}
+    assert not obj.specdeform.bound
+    assert np.abs(support.evaluated(obj) - rest).max() <= 1e-6 * diagonal, "unbind lost the input"
+    assert "specdeform_rest" not in obj.data.attributes
+    support.move(empty, np.eye(4))
+    assert np.array_equal(support.evaluated(obj), rest), "an unbound mesh followed its target"
+
+    # Apply keeps the deformation as the mesh's own and stops following.
+    obj.matrix_world = support.Matrix(np.eye(4).tolist())
+    bind(obj)
+    support.move(empty, T)
+    assert bpy.ops.specdeform.apply() == {"FINISHED"}
+    support.move(empty, np.eye(4))
+    assert np.abs(support.evaluated(obj) - X).max() <= 1e-5 * diagonal, "apply lost the result"
+    return obj
+
+
+def expect_refusal(obj, message):
+    bpy.context.view_layer.objects.active = obj
+    try:
+        bpy.ops.specdeform.bind()
+    except RuntimeError as e:
+        assert message in str(e), str(e)
+        assert not obj.specdeform.bound
+        return
+    raise AssertionError(f"bind accepted: expected '{message}'")
+
+
+def check_refusals(obj):
+    s = obj.specdeform
+    s.handle_group = "nowhere"
+    expect_refusal(obj, "no vertex group 'nowhere'")
+    obj.vertex_groups.new(name="empty")
+    s.handle_group = "empty"
+    expect_refusal(obj, "vertex group 'empty' holds no vertex")
+    s.handle_group, s.fixed_group = "handle", "missing"
+    expect_refusal(obj, "no vertex group 'missing'")
+    s.fixed_group, s.target = "fixed", None
+    expect_refusal(obj, "choose a target")
+
+
+def check_polygons():
+    """Quads are triangulated for the solve; the handle follows a translation exactly."""
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=30, y_subdivisions=30, size=2)
+    grid = bpy.context.object.data
+    co = support.mesh_helpers.coordinates(grid)
+    quads = np.empty(len(grid.loops), np.int32)
+    grid.loops.foreach_get("vertex_index", quads)
+    handle, fixed = np.flatnonzero(co[:, 0] > 0.8), np.flatnonzero(co[:, 0] < -0.8)
+    obj, empty = support.add_object("quads", co, quads.reshape(-1, 4), handle, fixed)
+    bind(obj)
+    T = np.eye(4)
+    T[:3, 3] = (0, 0, 0.3)
+    support.move(empty, T)
+    X = support.evaluated(obj)
+    assert np.abs(X[handle] - (co[handle] + T[:3, 3])).max() <= 0.005 * support.diagonal(co)
+    assert bpy.ops.specdeform.unbind() == {"FINISHED"}
+    assert np.array_equal(support.evaluated(obj), co)
+
+
+def main():
+    scene = twisted_bar_scene() if SCENE == "twisted-bar" else generated_scene()
+    support.fresh_file()
+    with tempfile.TemporaryDirectory() as workdir:
+        os.environ["XDG_CACHE_HOME"] = workdir  # a fresh basis cache
+        obj = check_deform(SCENE, *scene, workdir)
+        check_refusals(obj)
+        if SCENE == "generated":
+            check_polygons()
+    print("passed")
+
+
+main()
