@@ -546,13 +546,23 @@ try {
     check((await count(1)) === fixed.length, 'undo puts the fixed region back');
     await reset();
 
-    log('box select');
-    const boxSelect = async () => {
-      await keys('b');
-      await page.mouse.move(canvas.x - 60, canvas.y - 40);
-      await page.mouse.down();
-      await page.mouse.move(canvas.x + 60, canvas.y + 40, { steps: 4 });
-      await page.mouse.up();
+    log('box and lasso select');
+    const boxSelect = async (lasso = false) => {
+      if (lasso) {
+        // Ctrl + right-drag around a diamond: the lasso.
+        await page.keyboard.down('Control');
+        await page.mouse.move(canvas.x, canvas.y - 60);
+        await page.mouse.down({ button: 'right' });
+        for (const [dx, dy] of [[60, 0], [0, 60], [-60, 0], [0, -55]]) await page.mouse.move(canvas.x + dx, canvas.y + dy, { steps: 3 });
+        await page.mouse.up({ button: 'right' });
+        await page.keyboard.up('Control');
+      } else {
+        await keys('b');
+        await page.mouse.move(canvas.x - 60, canvas.y - 40);
+        await page.mouse.down();
+        await page.mouse.move(canvas.x + 60, canvas.y + 40, { steps: 4 });
+        await page.mouse.up();
+      }
       await waitReady(60000);
       const n = await count(1);
       await keys('Control+z');
@@ -565,7 +575,9 @@ try {
     const through = await boxSelect();
     await page.uncheck('#xray');
     await page.evaluate(() => document.activeElement?.blur());
-    log(`box: ${visible} visible, ${through} with X-ray`);
+    const lassoed = await boxSelect(true);
+    log(`box: ${visible} visible, ${through} with X-ray; lasso: ${lassoed}`);
+    check(lassoed > 0 && lassoed < visible, `the lasso (a diamond inside the box) selects fewer than the box (${lassoed})`);
     check(visible > 0 && through > 1.5 * visible, `a box selects the visible vertices (${visible}), with X-ray those behind too (${through})`);
 
     log('X mirror');

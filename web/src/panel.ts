@@ -135,7 +135,7 @@ export class Panel {
     });
     $('select-linked').addEventListener('click', () =>
       s.note('point at the piece and press L (the button cannot know where you point)'));
-    $('x-mirror').addEventListener('change', (e) => (this.ui.xMirror = (e.target as HTMLInputElement).checked));
+    $('x-mirror').addEventListener('change', (e) => (this.ui.xMirror.on = (e.target as HTMLInputElement).checked));
     $('select-box').addEventListener('click', () => this.ui.armBox());
     $('xray').addEventListener('change', (e) => (this.ui.xray = (e.target as HTMLInputElement).checked));
     $('select-invert').addEventListener('click', () => this.ui.selectTopology('invert'));
