@@ -19,7 +19,6 @@ class Binding:
     deformer: object
     rest: np.ndarray  # float32 (n, 3): the input, every vertex
     used: np.ndarray  # the vertices the faces use, in the deformer's numbering
-    targets: list  # one target object per handle group
     last: np.ndarray = None  # the transforms last solved for
     status: dict = field(default_factory=dict)
 
@@ -31,20 +30,26 @@ def binding(obj):
     return _bindings.get(obj.name_full)
 
 
+@bpy.app.handlers.persistent
 def forget_bindings(*_):
     _bindings.clear()
 
 
-def _local_transforms(obj, b):
+def _targets(obj):
+    """One target per handle group (read each time: undo replaces the objects)."""
+    return [obj.specdeform.target]
+
+
+def _local_transforms(obj):
     """Each target's transform since binding, in the object's local space: moving the object
     and its target together leaves the mesh as it is (as a Hook modifier does)."""
     in_target = Matrix(np.reshape(obj.specdeform.bound_matrix, (4, 4)).tolist())
     to_local = obj.matrix_world.inverted()
-    return np.array([to_local @ t.matrix_world @ in_target for t in b.targets])
+    return np.array([to_local @ t.matrix_world @ in_target for t in _targets(obj)])
 
 
 def _update(obj, b):
-    transforms = _local_transforms(obj, b)
+    transforms = _local_transforms(obj)
     if b.last is not None and np.array_equal(transforms, b.last):
         return
     start = time.perf_counter()
@@ -62,7 +67,10 @@ def _update(obj, b):
 def follow_targets(scene, _depsgraph):
     for obj in scene.objects:
         b = _bindings.get(obj.name_full) if obj.type == "MESH" else None
-        if b is None or not obj.specdeform.bound or not all(b.targets):
+        if b is None or not obj.specdeform.bound or not all(_targets(obj)):
+            continue
+        if len(b.rest) != len(obj.data.vertices):  # another mesh under this name
+            del _bindings[obj.name_full]
             continue
         try:
             _update(obj, b)
@@ -141,13 +149,13 @@ def _bind(obj, context):
         "basis": f"{len(evals)} modes, residual {h.max_residual:.1e}"
         + ("" if h.converged else " (approximate)"),
     }
-    b = Binding(d, rest, used, [s.target], status=status)
+    b = Binding(d, rest, used, status=status)
     if not s.bound:  # the input stays as it is until the target moves
         mesh_helpers.save_rest(mesh, rest)
         in_target = s.target.matrix_world.inverted() @ obj.matrix_world
         s.bound_matrix = [x for row in in_target for x in row]
         s.bound = True
-        b.last = _local_transforms(obj, b)
+        b.last = _local_transforms(obj)
     _bindings[obj.name_full] = b
     _update(obj, b)
     return None

@@ -100,6 +100,16 @@ def check_deform(name, V, F, handle, fixed, T, min_ring, workdir):
     support.move(empty, R @ T)
     assert np.abs(support.evaluated(obj) - X).max() <= 1e-5 * diagonal
 
+    # Saved and reopened: still bound, the binding asked for again, resumed from the saved input.
+    path = os.path.join(workdir, "bound.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    bpy.ops.wm.open_mainfile(filepath=path)
+    obj = bpy.data.objects[name]
+    assert obj.specdeform.bound and support.operators.binding(obj) is None
+    bind(obj)
+    assert np.abs(support.evaluated(obj) - X).max() <= 1e-5 * diagonal
+    empty = obj.specdeform.target
+
     assert bpy.ops.specdeform.unbind() == {"FINISHED"}
     assert not obj.specdeform.bound
     assert np.abs(support.evaluated(obj) - rest).max() <= 1e-6 * diagonal, "unbind lost the input"
