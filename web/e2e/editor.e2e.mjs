@@ -418,6 +418,12 @@ try {
       await page.evaluate(() => document.activeElement?.blur());
       await waitReady(60000);
     };
+    const undoTwice = async () => {
+      for (let i = 0; i < 2; ++i) {
+        await keys('Control+z');
+        await waitReady(60000); // a busy page ignores the next
+      }
+    };
     const centroid = (r) => {
       const c = [0, 0, 0];
       let n = 0;
@@ -497,8 +503,30 @@ try {
     const fixedPoint = [0, 1, 2].map((i) => r.t[4 * i] * cursor[0] + r.t[4 * i + 1] * cursor[1] + r.t[4 * i + 2] * cursor[2] + r.t[4 * i + 3]);
     check(r.t[1] === -1 && Math.hypot(...fixedPoint.map((x, k) => x - cursor[k])) < 1e-9 * r.diagonal,
       `R Z 90 turns about the 3D cursor (${cursor} goes to ${fixedPoint})`);
-    await page.selectOption('#pivot', 'median');
     await reset();
+
+    // Individual pivots: a second group at the other end; R Z 90 turns each about its centroid.
+    await page.selectOption('#pivot', 'individual');
+    await page.evaluate(() => document.activeElement?.blur());
+    await keys('n');
+    await click(ends.fixed);
+    await keys('4', 'r', 'z', '9', '0', 'Enter');
+    r = await result();
+    const both = await api(() => window.specdeformEditor.transforms());
+    for (const [g, t] of both.entries()) {
+      const c = [0, 1, 2].map((k) => {
+        let sum = 0, n = 0;
+        r.labels.forEach((l, v) => l === 2 + g && (++n, (sum += r.rest[3 * v + k])));
+        return sum / n;
+      });
+      const image = [0, 1, 2].map((i) => t[4 * i] * c[0] + t[4 * i + 1] * c[1] + t[4 * i + 2] * c[2] + t[4 * i + 3]);
+      check(t[1] === -1 && Math.hypot(...image.map((x, k) => x - c[k])) < 1e-9 * r.diagonal, `group ${g + 1} turned about its own centroid`);
+    }
+    check(both.length === 2, `two groups turned (${both.length})`);
+    await undoTwice();
+    await page.selectOption('#pivot', 'median');
+    await page.evaluate(() => document.activeElement?.blur());
+    await keys('1');
 
     log('views');
     const looking = () => api(() => {
@@ -514,12 +542,6 @@ try {
     check((await looking())[2] > 0.999, 'numpad 1 looks from the front');
 
     log('select linked, invert, grow, shrink');
-    const undoTwice = async () => {
-      for (let i = 0; i < 2; ++i) {
-        await keys('Control+z');
-        await waitReady(60000); // a busy page ignores the next
-      }
-    };
     const count = async (label) => (await api(() => window.specdeformEditor.labels())).filter((l) => l === label).length;
     const handles0 = await count(2);
     await keys('1');

@@ -9,9 +9,9 @@ import { EditorState, FIXED, FREE } from './state';
 import { Mode, ModalTransform } from './transform';
 
 export type Tool = 'handle' | 'fixed' | 'erase' | 'move' | 'pin';
-// Rotations and scales turn about the active group's centroid (Blender's median point) or the
-// 3D cursor.
-export type PivotMode = 'median' | 'cursor';
+// Rotations and scales turn about the active group's centroid (Blender's median point), the
+// 3D cursor, or (G, R, S only) every movable group about its own centroid.
+export type PivotMode = 'median' | 'cursor' | 'individual';
 
 // How long the pointer rests before the full detail is asked for in place of the preview (ms).
 const kRestMs = 200;
@@ -22,6 +22,7 @@ interface Drag {
   transform: THREE.Matrix4; // the group's at the start
   pivot?: THREE.Matrix4; // the gizmo's at the start
   modal?: ModalTransform; // G, R or S from the keyboard
+  others?: { group: number; transform: THREE.Matrix4; modal: ModalTransform }[]; // individual pivots
 }
 
 export class Interaction {
@@ -316,7 +317,10 @@ export class Interaction {
       this.showHeader('');
       this.s.viewer.orbit.enabled = true;
     }
-    if (!keep) this.s.groups[d.group].transform = d.transform;
+    if (!keep) {
+      this.s.groups[d.group].transform = d.transform;
+      for (const o of d.others ?? []) this.s.groups[o.group].transform = o.transform;
+    }
     this.xMirror.follow(this.s.groups, d.group);
     if (this.usedPreview || !keep) this.s.sendFrame(false);
     if (keep) this.s.commit();
@@ -407,8 +411,13 @@ export class Interaction {
     }
     const diagonal = s.ready?.diagonal ?? 1;
     const step = 10 ** Math.floor(Math.log10(diagonal / 20)); // Ctrl snaps a move to this
-    const modal = new ModalTransform(mode, pivot, group.transform.clone(), { ...this.pointer }, s.viewer, step);
-    this.drag = { group: g, start: pivot, transform: group.transform.clone(), modal };
+    const modalOf = (k: number, at: THREE.Vector3) =>
+      new ModalTransform(mode, at, s.groups[k].transform.clone(), { ...this.pointer }, s.viewer, step);
+    const others = this.pivotMode !== 'individual' ? [] : s.groups.flatMap((x, k) => {
+      const c = k !== g && !x.pinned ? this.restCentroid(k) : null;
+      return c ? [{ group: k, transform: x.transform.clone(), modal: modalOf(k, c.applyMatrix4(x.transform)) }] : [];
+    });
+    this.drag = { group: g, start: pivot, transform: group.transform.clone(), modal: modalOf(g, pivot), others };
     this.usedPreview = false;
     s.viewer.gizmo.detach();
     s.viewer.orbit.enabled = false;
@@ -439,7 +448,13 @@ export class Interaction {
 
   private modalMoved(): void {
     const d = this.drag!;
-    this.s.groups[d.group].transform = d.modal!.matrix(this.pointer);
+    const m = d.modal!;
+    this.s.groups[d.group].transform = m.matrix(this.pointer);
+    for (const o of d.others ?? []) {
+      // The same axis, value and snapping, each about its own centroid and along its own axes.
+      Object.assign(o.modal, { lock: m.lock && { ...m.lock }, typed: m.typed, snap: m.snap });
+      this.s.groups[o.group].transform = o.modal.matrix(this.pointer);
+    }
     this.showHeader(d.modal!.readout(this.pointer));
     this.dragged();
   }
