@@ -432,6 +432,14 @@ try {
     };
     await reset();
     await page.keyboard.press('4');
+    // The gizmo is at the pivot, in view and clear of the messages over the viewport.
+    const gizmo = await api(() => window.specdeformEditor.gizmoOnScreen());
+    const clear = await page.evaluate(() => {
+      const c = document.querySelector('#view canvas').getBoundingClientRect();
+      return { left: c.left, right: c.right, top: document.querySelector('#overlay').getBoundingClientRect().bottom, bottom: c.bottom };
+    });
+    check(gizmo && gizmo.x > clear.left && gizmo.x < clear.right && gizmo.y > clear.top && gizmo.y < clear.bottom,
+      `the gizmo is in view, below the messages (${JSON.stringify(gizmo)} in ${JSON.stringify(clear)})`);
     const step = Number((0.2 * state.diagonal).toPrecision(1));
     await keys('g', 'x', ...String(step));
     check(/Move D: .* \[.*\|\] along global X/.test(await page.textContent('#header')), `the header reads the move (${await page.textContent('#header')})`);
