@@ -59,6 +59,7 @@ def _update(obj, b):
     co[b.used] = X
     b.last = transforms  # before writing: the write triggers this handler again
     mesh_helpers.set_coordinates(obj.data, co)
+    b.status["iterations"] = b.deformer.report.get("iterations", 0)
     b.status["solve_ms"] = 1e3 * (solved - start)
     b.status["write_ms"] = 1e3 * (time.perf_counter() - solved)
 

@@ -43,7 +43,8 @@ class VIEW3D_PT_specdeform(bpy.types.Panel):
             layout.label(text=f"Basis: {st['basis']}")
             layout.label(text=f"Bind {st['bind_s']:.2f} s (basis {st['basis_s']:.2f} s)")
             if "solve_ms" in st:
-                solve, write = st["solve_ms"], st["write_ms"]
-                layout.label(text=f"Update: solve {solve:.1f} ms, write {write:.1f} ms")
+                solve, write, its = st["solve_ms"], st["write_ms"], st["iterations"]
+                layout.label(text=f"Update: solve {solve:.1f} ms ({its} iterations)")
+                layout.label(text=f"Write {write:.1f} ms")
             if "error" in st:
                 layout.label(text=st["error"], icon="ERROR")

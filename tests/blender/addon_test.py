@@ -32,6 +32,7 @@ if SCENE == "mismatch":
     assert message.startswith("specdeform module not loadable in Blender's Python 3.")
     bpy.ops.mesh.primitive_cube_add()
     assert not bpy.ops.specdeform.bind.poll()
+    assert support.panel_lines(bpy.context.object) == [message]
     sys.exit(0)
 
 import specdeform  # noqa: E402
@@ -92,6 +93,9 @@ def check_deform(name, V, F, handle, fixed, T, min_ring, workdir):
     assert to_cli <= 1e-5, to_cli
     assert miss <= 0.005 * diagonal, miss / diagonal
     assert ring >= min_ring, ring  # the linear energy: 0.25-0.4
+    lines = support.panel_lines(obj)
+    assert lines[0].startswith("Basis: 100 modes, residual") and "approximate" not in lines[0]
+    assert lines[2].startswith("Update: solve") and "iterations" in lines[2], lines
 
     # The object moved and turned with its target: the deformation is the same in local space.
     R = np.array(support.Matrix.Rotation(0.7, 4, (1, 2, 3)))
@@ -106,6 +110,7 @@ def check_deform(name, V, F, handle, fixed, T, min_ring, workdir):
     bpy.ops.wm.open_mainfile(filepath=path)
     obj = bpy.data.objects[name]
     assert obj.specdeform.bound and support.operators.binding(obj) is None
+    assert support.panel_lines(obj) == ["Bound in the file: press Bind to resume"]
     bind(obj)
     assert np.abs(support.evaluated(obj) - X).max() <= 1e-5 * diagonal
     empty = obj.specdeform.target
