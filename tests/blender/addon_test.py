@@ -152,8 +152,19 @@ def check_refusals(obj):
     expect_refusal(obj, "vertex group 'empty' holds no vertex")
     s.handle_group, s.fixed_group = "handle", "missing"
     expect_refusal(obj, "no vertex group 'missing'")
-    s.fixed_group, s.target = "fixed", None
+    target, s.fixed_group, s.target = s.target, "fixed", None
     expect_refusal(obj, "choose a target")
+    s.target = target
+
+
+def check_cancel(obj):
+    """The panel's Bind computes the basis on a worker thread that Esc cancels."""
+    obj.specdeform.modes = 60  # not in the cache
+    job = support.operators.BasisJob(support.operators._request(obj))
+    job.cancel()
+    assert job.join().error == "cancelled" and job.result is None, job.error
+    assert not any("-m60-" in f for f in os.listdir(support.library.cache_dir()))
+    obj.specdeform.modes = 100
 
 
 def check_polygons():
@@ -182,6 +193,7 @@ def main():
         os.environ["XDG_CACHE_HOME"] = workdir  # a fresh basis cache
         obj = check_deform(SCENE, *scene, workdir)
         check_refusals(obj)
+        check_cancel(obj)
         if SCENE == "generated":
             check_polygons()
     print("passed")
