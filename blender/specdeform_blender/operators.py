@@ -59,6 +59,7 @@ def _update(obj, b):
     co[b.used] = X
     b.last = transforms  # before writing: the write triggers this handler again
     mesh_helpers.set_coordinates(obj.data, co)
+    b.status.pop("error", None)
     b.status["iterations"] = b.deformer.report.get("iterations", 0)
     b.status["solve_ms"] = 1e3 * (solved - start)
     b.status["write_ms"] = 1e3 * (time.perf_counter() - solved)
@@ -68,7 +69,7 @@ def _update(obj, b):
 def follow_targets(scene, _depsgraph):
     for obj in scene.objects:
         b = _bindings.get(obj.name_full) if obj.type == "MESH" else None
-        if b is None or not obj.specdeform.bound or not all(_targets(obj)):
+        if b is None or not obj.specdeform.bound or obj.mode == "EDIT" or not all(_targets(obj)):
             continue
         if len(b.rest) != len(obj.data.vertices):  # another mesh under this name
             del _bindings[obj.name_full]
