@@ -418,6 +418,11 @@ try {
       await page.evaluate(() => document.activeElement?.blur());
       await waitReady(60000);
     };
+    // Messages over the viewport take clicks: dismissed before clicking the model under them.
+    const dismiss = async () => {
+      for (const close of await page.$$('#notes .note button')) await close.click().catch(() => {});
+      await page.evaluate(() => document.activeElement?.blur());
+    };
     const undoTwice = async () => {
       for (let i = 0; i < 2; ++i) {
         await keys('Control+z');
@@ -498,6 +503,7 @@ try {
     // The 3D cursor as the pivot: Shift + right-click on the handle's end, then R Z 90 turns
     // about that point.
     await reset();
+    await dismiss();
     const at = await screen(ends.handle);
     await page.keyboard.down('Shift');
     await page.mouse.click(at.x, at.y, { button: 'right' });
@@ -517,6 +523,7 @@ try {
     await page.selectOption('#pivot', 'individual');
     await page.evaluate(() => document.activeElement?.blur());
     await keys('n');
+    await dismiss();
     await click(ends.fixed);
     await keys('4', 'r', 'z', '9', '0', 'Enter');
     r = await result();
@@ -574,6 +581,12 @@ try {
     check((await count(1)) === 0 || (await count(1)) < linked, 'invert swaps fixed and free');
     await undoTwice();
     check((await count(1)) === fixed.length, 'undo puts the fixed region back');
+    await page.click('#select-linked'); // the button: the next click picks the piece
+    await page.mouse.click(canvas.x, canvas.y);
+    await waitReady(60000);
+    check((await count(1)) === linked, `Linked, then a click, selects the same piece (${await count(1)})`);
+    await keys('Control+z');
+    await waitReady(60000);
     await reset();
 
     log('box and lasso select');
@@ -615,6 +628,7 @@ try {
     await page.check('#x-mirror');
     await page.evaluate(() => document.activeElement?.blur());
     await keys('1');
+    await dismiss();
     await click(ends.handle);
     r = await result();
     const side = (label) => r.labels.flatMap((l, v) => (l === label ? [v] : []));

@@ -44,6 +44,7 @@ export class Interaction {
   // B arms a box (drawn with the left button); Ctrl + right-drag draws a lasso.
   private region: { armed: boolean; lasso: boolean; path: Point[] } = { armed: false, lasso: false, path: [] };
   xray = false; // box and lasso select through the surface
+  private linkedArmed = false; // the Linked button: the next click picks the piece
 
   constructor(private readonly s: EditorState, private readonly view: HTMLElement) {
     const v = s.viewer;
@@ -90,6 +91,13 @@ export class Interaction {
       return;
     }
     if (e.button === 2 && e.shiftKey) this.cursorPress = { x: e.clientX, y: e.clientY };
+    if (this.linkedArmed && e.button === 0 && e.target === v.canvas) {
+      e.stopPropagation();
+      this.linkedArmed = false;
+      this.showHeader('');
+      this.pointer = { x: e.clientX, y: e.clientY };
+      return this.selectTopology('linked');
+    }
     const lasso = e.button === 2 && e.ctrlKey && this.s.editable;
     if (e.target === v.canvas && ((this.region.armed && e.button === 0) || lasso)) {
       e.stopPropagation();
@@ -474,6 +482,13 @@ export class Interaction {
     return this.topology.brush;
   }
 
+  // The Linked button: the next left click selects the piece under it (L does it at once).
+  armLinked(): void {
+    if (!this.s.editable || this.stroke || this.drag) return;
+    this.linkedArmed = true;
+    this.showHeader('Select linked: click the piece to select; Esc cancels');
+  }
+
   // B: the next left drag draws a rectangle; its vertices get the tool's label.
   armBox(): void {
     if (!this.s.editable || this.stroke || this.drag) return;
@@ -557,6 +572,11 @@ export class Interaction {
   // Escape: cancels a drag or a stroke; returns whether there was one.
   cancel(): boolean {
     if (this.endRegion(null)) return true;
+    if (this.linkedArmed) {
+      this.linkedArmed = false;
+      this.showHeader('');
+      return true;
+    }
     if (this.drag) {
       const gizmo = this.drag.pivot !== undefined;
       const modal = this.drag.modal !== undefined;
