@@ -194,8 +194,8 @@ def _finish(obj, r, job):
     status = {
         "basis_s": job.seconds,
         "bind_s": job.seconds + time.perf_counter() - start,
-        "basis": f"{len(evals)} modes, residual {h.max_residual:.1e}"
-        + ("" if h.converged else " (approximate)"),
+        "basis": f"{len(evals)} modes" + ("" if h.converged else ", approximate"),
+        "residual": h.max_residual,
     }
     b = Binding(d, r.rest, r.used, status=status)
     if not s.bound:  # the input stays as it is until the target moves
