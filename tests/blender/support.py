@@ -13,7 +13,7 @@ import numpy as np  # noqa: E402
 from mathutils import Matrix  # noqa: E402
 
 import specdeform_blender  # noqa: E402
-from specdeform_blender import library, mesh_helpers, operators  # noqa: E402
+from specdeform_blender import library, mesh_helpers, operators  # noqa: E402, F401 (for the tests)
 
 SKIP = 77  # CTest's SKIP_RETURN_CODE
 
