@@ -522,7 +522,7 @@ try {
     // Individual pivots: a second group at the other end; R Z 90 turns each about its centroid.
     await page.selectOption('#pivot', 'individual');
     await page.evaluate(() => document.activeElement?.blur());
-    await keys('n');
+    await keys('n', 'Home'); // the first view again (Move may have panned the gizmo into view)
     await dismiss();
     await click(ends.fixed);
     await keys('4', 'r', 'z', '9', '0', 'Enter');
