@@ -18,7 +18,7 @@ const kRestMs = 200;
 
 interface Drag {
   group: number;
-  start: THREE.Vector3; // the handle point grabbed (mouse) or the gizmo's start
+  start: THREE.Vector3; // the handle point grabbed (mouse), the gizmo's start or the pivot (G, R, S)
   transform: THREE.Matrix4; // the group's at the start
   pivot?: THREE.Matrix4; // the gizmo's at the start
   modal?: ModalTransform; // G, R or S from the keyboard
