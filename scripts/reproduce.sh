@@ -2,10 +2,15 @@
 # Regenerates docs/results/: the paper's Table 1, Fig. 5 and Fig. 6 measured on this machine,
 # pictures of the pipeline (original, smooth base, deformed base, detailed result), all with the
 # paper's linear energy; the linear energy, spectral ARAP and CGAL's SR-ARAP on scenes that turn
+<<<<<<< HEAD
 # (tables and pictures); the intrinsic Delaunay Laplacian against the cotan one on every
 # shared model; and the exact and the multilevel basis on subdivided meshes up to 2.77M vertices.
+=======
+# (tables and pictures); the Blender add-on against Blender's Laplacian Deform; and the intrinsic
+# Delaunay Laplacian against the cotan one on every shared model.
+>>>>>>> main
 # Needs ../shared/meshes (the test meshes) and a build (scripts/setup.sh); installs
-# python3-matplotlib for the plot and chromium for the pictures where missing.
+# python3-matplotlib for the plot, chromium for the pictures and blender where missing.
 # Usage: scripts/reproduce.sh [OUT]     (default: docs/results; takes about 30 minutes)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,7 +20,7 @@ scenes=../shared/meshes/scenes
 bin=build/bin/specdeform
 [ -d "$models" ] || { echo "reproduce: $models not found (the shared test meshes)" >&2; exit 1; }
 [ -x "$bin" ] || { echo "reproduce: $bin not found (run scripts/setup.sh)" >&2; exit 1; }
-scripts/apt_install.sh python3-matplotlib chromium
+scripts/apt_install.sh python3-matplotlib chromium blender
 mkdir -p "$out/pictures"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -84,6 +89,12 @@ scripts/rotations_table.py "$out/rotations.md" \
   "bumpy tube, twist 150 degrees=$out/rotations_bumpy_tube_twist.json" \
   "bumpy tube, bend 100 degrees=$out/rotations_bumpy_tube_bend.json" \
   "armadillo hand=$out/rotations_armadillo_hand.json"
+
+echo "== Blender: the add-on against Laplacian Deform (same process, medians of 21 updates)"
+SPECDEFORM_BLENDER_DIR=build/blender SPECDEFORM_SHARED_DIR=../shared PYTHONDONTWRITEBYTECODE=1 \
+  blender -b --factory-startup --python-exit-code 1 \
+  --python benchmarks/blender_vs_laplacian_deform.py -- --updates 21 --reference "$work" \
+  --markdown "$out/blender_vs_laplacian_deform.md" --json "$out/blender_vs_laplacian_deform.json"
 
 echo "== A robust Laplacian: each Laplacian's eigenvalues against a finer remeshing"
 for mass in lumped consistent; do

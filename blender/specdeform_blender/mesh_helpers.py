@@ -25,7 +25,8 @@ def triangles(mesh):
 
 
 def group_members(obj, name):
-    """Indices of the vertices in vertex group `name` with a weight above 0."""
+    """Indices of the vertices in vertex group `name` with a weight above 0 (a loop over the
+    vertices, at Bind only: Blender 3.4 has no bulk access to vertex group weights)."""
     index = obj.vertex_groups[name].index
     return np.array(
         [v.index for v in obj.data.vertices for g in v.groups if g.group == index and g.weight > 0],

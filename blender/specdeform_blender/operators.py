@@ -19,7 +19,6 @@ class Binding:
     deformer: object
     rest: np.ndarray  # float32 (n, 3): the input, every vertex
     used: np.ndarray  # the vertices the faces use, in the deformer's numbering
-    targets: list  # one target object per handle group
     last: np.ndarray = None  # the transforms last solved for
     status: dict = field(default_factory=dict)
 
@@ -31,20 +30,26 @@ def binding(obj):
     return _bindings.get(obj.name_full)
 
 
+@bpy.app.handlers.persistent
 def forget_bindings(*_):
     _bindings.clear()
 
 
-def _local_transforms(obj, b):
+def _targets(obj):
+    """One target per handle group (read each time: undo replaces the objects)."""
+    return [obj.specdeform.target]
+
+
+def _local_transforms(obj):
     """Each target's transform since binding, in the object's local space: moving the object
     and its target together leaves the mesh as it is (as a Hook modifier does)."""
     in_target = Matrix(np.reshape(obj.specdeform.bound_matrix, (4, 4)).tolist())
     to_local = obj.matrix_world.inverted()
-    return np.array([to_local @ t.matrix_world @ in_target for t in b.targets])
+    return np.array([to_local @ t.matrix_world @ in_target for t in _targets(obj)])
 
 
 def _update(obj, b):
-    transforms = _local_transforms(obj, b)
+    transforms = _local_transforms(obj)
     if b.last is not None and np.array_equal(transforms, b.last):
         return
     start = time.perf_counter()
@@ -54,6 +59,8 @@ def _update(obj, b):
     co[b.used] = X
     b.last = transforms  # before writing: the write triggers this handler again
     mesh_helpers.set_coordinates(obj.data, co)
+    b.status.pop("error", None)
+    b.status["iterations"] = b.deformer.report.get("iterations", 0)
     b.status["solve_ms"] = 1e3 * (solved - start)
     b.status["write_ms"] = 1e3 * (time.perf_counter() - solved)
 
@@ -62,7 +69,10 @@ def _update(obj, b):
 def follow_targets(scene, _depsgraph):
     for obj in scene.objects:
         b = _bindings.get(obj.name_full) if obj.type == "MESH" else None
-        if b is None or not obj.specdeform.bound or not all(b.targets):
+        if b is None or not obj.specdeform.bound or obj.mode == "EDIT" or not all(_targets(obj)):
+            continue
+        if len(b.rest) != len(obj.data.vertices):  # another mesh under this name
+            del _bindings[obj.name_full]
             continue
         try:
             _update(obj, b)
@@ -70,9 +80,21 @@ def follow_targets(scene, _depsgraph):
             b.status["error"] = str(e)
 
 
-def _bind(obj, context):
-    """Binds `obj` (its saved rest and target matrix when it is bound already). Returns an
-    error message, or None."""
+@dataclass
+class Request:
+    """What Bind reads from the object and its settings before the basis is computed."""
+
+    rest: np.ndarray
+    used: np.ndarray
+    V: np.ndarray
+    F: np.ndarray
+    handle: np.ndarray
+    fixed: np.ndarray
+    modes: int
+
+
+def _request(obj):
+    """Bind's input from `obj` (its saved rest when it is bound already), or an error message."""
     s = obj.specdeform
     groups = obj.vertex_groups
     if not s.handle_group or s.handle_group not in groups:
@@ -91,63 +113,97 @@ def _bind(obj, context):
     if len(F) == 0:
         return "the mesh has no faces"
     used, F = np.unique(F, return_inverse=True)  # loose vertices stay where they are
-    F = F.reshape(-1, 3).astype(np.int32)
     renumber = np.full(len(rest), -1, np.int64)
     renumber[used] = np.arange(len(used))
-    handle = renumber[mesh_helpers.group_members(obj, s.handle_group)]
-    handle = handle[handle >= 0]
-    if len(handle) == 0:
-        return f"vertex group '{s.handle_group}' holds no vertex of a face"
-    fixed = np.empty(0, np.int64)
-    if s.fixed_group:
-        fixed = renumber[mesh_helpers.group_members(obj, s.fixed_group)]
-        fixed = fixed[fixed >= 0]
-        if len(fixed) == 0:
-            return f"vertex group '{s.fixed_group}' holds no vertex of a face"
+    members = {}
+    for name in filter(None, (s.handle_group, s.fixed_group)):
+        members[name] = renumber[mesh_helpers.group_members(obj, name)]
+        members[name] = members[name][members[name] >= 0]
+        if len(members[name]) == 0:
+            return f"vertex group '{name}' holds no vertex of a face"
+    return Request(rest, used, rest[used].astype(np.float64), F.reshape(-1, 3).astype(np.int32),
+                   members[s.handle_group], members.get(s.fixed_group, np.empty(0, np.int64)),
+                   s.modes)
 
+
+class _Cancelled(Exception):
+    pass
+
+
+class BasisJob:
+    """A Request's basis computed, or loaded from the cache, on a worker thread (the module
+    releases the GIL); cancel() stops it at the solver's next progress report."""
+
+    def __init__(self, request):
+        self.fraction, self.result, self.error, self.seconds = 0.0, None, None, 0.0
+        self._cancel = threading.Event()
+        self._thread = threading.Thread(target=self._run, args=(request,), daemon=True)
+        self._thread.start()
+
+    def _progress(self, fraction, _stage):
+        if self._cancel.is_set():
+            raise _Cancelled
+        self.fraction = fraction
+
+    def _run(self, r):
+        start = time.perf_counter()
+        try:
+            os.makedirs(library.cache_dir(), exist_ok=True)
+            self.result = library.specdeform.manifold_harmonics(
+                r.V, r.F, r.modes, cache=library.cache_dir(), progress=self._progress
+            )
+        except _Cancelled:
+            self.error = "cancelled"
+        except (library.specdeform.Error, OSError) as e:
+            self.error = str(e)
+        self.seconds = time.perf_counter() - start
+
+    def cancel(self):
+        self._cancel.set()
+
+    def join(self):
+        self._thread.join()
+        return self
+
+    @property
+    def done(self):
+        return not self._thread.is_alive()
+
+
+def _finish(obj, r, job):
+    """Binds `obj` to the basis `job` computed. Returns an error message, or None."""
+    if job.error:
+        return f"bind: {job.error}"
+    s = obj.specdeform
     sd = library.specdeform
-    V = rest[used].astype(np.float64)
-    wm = context.window_manager
-    main = threading.main_thread()
-
-    def progress(fraction, _stage):
-        if threading.current_thread() is main:
-            wm.progress_update(int(100 * fraction))
-
-    cache = library.cache_dir()
-    os.makedirs(cache, exist_ok=True)
     start = time.perf_counter()
-    wm.progress_begin(0, 100)
+    evals, evecs = job.result
     try:
-        evals, evecs = sd.manifold_harmonics(V, F, s.modes, cache=cache, progress=progress)
-        basis_s = time.perf_counter() - start
         d = sd.SpectralDeformer(
-            V,
-            F,
+            r.V,
+            r.F,
             basis=(evals, evecs),
             energy=s.energy,
             detail=s.detail,
             constraint_weight=s.constraint_weight,
         )
-        d.set_selection(handles=[handle], fixed=fixed)
+        d.set_selection(handles=[r.handle], fixed=r.fixed)
     except sd.Error as e:
         return str(e)
-    finally:
-        wm.progress_end()
     h = evecs.base
     status = {
-        "basis_s": basis_s,
-        "bind_s": time.perf_counter() - start,
-        "basis": f"{len(evals)} modes, residual {h.max_residual:.1e}"
-        + ("" if h.converged else " (approximate)"),
+        "basis_s": job.seconds,
+        "bind_s": job.seconds + time.perf_counter() - start,
+        "basis": f"{len(evals)} modes" + ("" if h.converged else ", approximate"),
+        "residual": h.max_residual,
     }
-    b = Binding(d, rest, used, [s.target], status=status)
+    b = Binding(d, r.rest, r.used, status=status)
     if not s.bound:  # the input stays as it is until the target moves
-        mesh_helpers.save_rest(mesh, rest)
+        mesh_helpers.save_rest(obj.data, r.rest)
         in_target = s.target.matrix_world.inverted() @ obj.matrix_world
         s.bound_matrix = [x for row in in_target for x in row]
         s.bound = True
-        b.last = _local_transforms(obj, b)
+        b.last = _local_transforms(obj)
     _bindings[obj.name_full] = b
     _update(obj, b)
     return None
@@ -170,7 +226,42 @@ class SPECDEFORM_OT_bind(bpy.types.Operator):
         return _poll_mesh(context) and context.mode == "OBJECT"
 
     def execute(self, context):
-        error = _bind(context.object, context)
+        r = _request(context.object)
+        error = r if isinstance(r, str) else _finish(context.object, r, BasisJob(r).join())
+        return self._done(error)
+
+    def invoke(self, context, _event):
+        """From the panel: the basis on a worker thread, progress in the status bar, Esc to
+        cancel."""
+        self.obj = context.object
+        self.r = _request(self.obj)
+        if isinstance(self.r, str):
+            return self._done(self.r)
+        self.job = BasisJob(self.r)
+        wm = context.window_manager
+        wm.progress_begin(0, 100)
+        self.timer = wm.event_timer_add(0.1, window=context.window)
+        wm.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        if event.type == "ESC":
+            self.job.cancel()
+        if event.type != "TIMER":
+            return {"RUNNING_MODAL"}
+        wm = context.window_manager
+        wm.progress_update(int(100 * self.job.fraction))
+        context.workspace.status_text_set(
+            f"specdeform: basis {100 * self.job.fraction:.0f}% (Esc cancels)"
+        )
+        if not self.job.done:
+            return {"RUNNING_MODAL"}
+        wm.event_timer_remove(self.timer)
+        wm.progress_end()
+        context.workspace.status_text_set(None)
+        return self._done(_finish(self.obj, self.r, self.job))
+
+    def _done(self, error):
         if error:
             self.report({"ERROR"}, error)
             return {"CANCELLED"}

@@ -41,9 +41,10 @@ class VIEW3D_PT_specdeform(bpy.types.Panel):
         elif b is not None:
             st = b.status
             layout.label(text=f"Basis: {st['basis']}")
+            layout.label(text=f"Residual {st['residual']:.0e}")
             layout.label(text=f"Bind {st['bind_s']:.2f} s (basis {st['basis_s']:.2f} s)")
             if "solve_ms" in st:
-                solve, write = st["solve_ms"], st["write_ms"]
-                layout.label(text=f"Update: solve {solve:.1f} ms, write {write:.1f} ms")
+                layout.label(text=f"Solve {st['solve_ms']:.1f} ms, {st['iterations']} iterations")
+                layout.label(text=f"Write {st['write_ms']:.1f} ms")
             if "error" in st:
                 layout.label(text=st["error"], icon="ERROR")

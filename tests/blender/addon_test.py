@@ -32,6 +32,7 @@ if SCENE == "mismatch":
     assert message.startswith("specdeform module not loadable in Blender's Python 3.")
     bpy.ops.mesh.primitive_cube_add()
     assert not bpy.ops.specdeform.bind.poll()
+    assert support.panel_lines(bpy.context.object) == [message]
     sys.exit(0)
 
 import specdeform  # noqa: E402
@@ -92,6 +93,9 @@ def check_deform(name, V, F, handle, fixed, T, min_ring, workdir):
     assert to_cli <= 1e-5, to_cli
     assert miss <= 0.005 * diagonal, miss / diagonal
     assert ring >= min_ring, ring  # the linear energy: 0.25-0.4
+    lines = support.panel_lines(obj)
+    assert lines[0] == "Basis: 100 modes" and lines[1].startswith("Residual"), lines
+    assert lines[3].startswith("Solve") and lines[3].endswith("iterations"), lines
 
     # The object moved and turned with its target: the deformation is the same in local space.
     R = np.array(support.Matrix.Rotation(0.7, 4, (1, 2, 3)))
@@ -99,6 +103,17 @@ def check_deform(name, V, F, handle, fixed, T, min_ring, workdir):
     obj.matrix_world = support.Matrix(R.tolist())
     support.move(empty, R @ T)
     assert np.abs(support.evaluated(obj) - X).max() <= 1e-5 * diagonal
+
+    # Saved and reopened: still bound, the binding asked for again, resumed from the saved input.
+    path = os.path.join(workdir, "bound.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    bpy.ops.wm.open_mainfile(filepath=path)
+    obj = bpy.data.objects[name]
+    assert obj.specdeform.bound and support.operators.binding(obj) is None
+    assert support.panel_lines(obj) == ["Bound in the file: press Bind to resume"]
+    bind(obj)
+    assert np.abs(support.evaluated(obj) - X).max() <= 1e-5 * diagonal
+    empty = obj.specdeform.target
 
     assert bpy.ops.specdeform.unbind() == {"FINISHED"}
     assert not obj.specdeform.bound
@@ -137,8 +152,19 @@ def check_refusals(obj):
     expect_refusal(obj, "vertex group 'empty' holds no vertex")
     s.handle_group, s.fixed_group = "handle", "missing"
     expect_refusal(obj, "no vertex group 'missing'")
-    s.fixed_group, s.target = "fixed", None
+    target, s.fixed_group, s.target = s.target, "fixed", None
     expect_refusal(obj, "choose a target")
+    s.target = target
+
+
+def check_cancel(obj):
+    """The panel's Bind computes the basis on a worker thread that Esc cancels."""
+    obj.specdeform.modes = 60  # not in the cache
+    job = support.operators.BasisJob(support.operators._request(obj))
+    job.cancel()
+    assert job.join().error == "cancelled" and job.result is None, job.error
+    assert not any("-m60-" in f for f in os.listdir(support.library.cache_dir()))
+    obj.specdeform.modes = 100
 
 
 def check_polygons():
@@ -167,6 +193,7 @@ def main():
         os.environ["XDG_CACHE_HOME"] = workdir  # a fresh basis cache
         obj = check_deform(SCENE, *scene, workdir)
         check_refusals(obj)
+        check_cancel(obj)
         if SCENE == "generated":
             check_polygons()
     print("passed")

@@ -13,7 +13,7 @@ import numpy as np  # noqa: E402
 from mathutils import Matrix  # noqa: E402
 
 import specdeform_blender  # noqa: E402
-from specdeform_blender import mesh_helpers  # noqa: E402
+from specdeform_blender import library, mesh_helpers, operators  # noqa: E402, F401 (for the tests)
 
 SKIP = 77  # CTest's SKIP_RETURN_CODE
 
@@ -83,3 +83,34 @@ def ring_ratios(rest, deformed):
 
 def apply_transform(T, X):
     return X @ T[:3, :3].T + T[:3, 3]
+
+
+class Layout:
+    """Records what a panel's draw() asks for: bpy's UILayout exists only with a window."""
+
+    def __init__(self, labels=None):
+        self.labels = [] if labels is None else labels
+        self.enabled = True
+
+    def label(self, text="", icon="NONE"):
+        self.labels.append(text)
+
+    def row(self, **_):
+        return Layout(self.labels)
+
+    column = row
+
+    def prop(self, *_, **__):
+        pass
+
+    prop_search = operator = prop
+
+
+def panel_lines(obj):
+    """The lines of text the sidebar panel shows for `obj`."""
+    from specdeform_blender import ui
+
+    panel = type("Panel", (), {"layout": Layout()})()
+    context = type("Context", (), {"object": obj})()
+    ui.VIEW3D_PT_specdeform.draw(panel, context)
+    return panel.layout.labels

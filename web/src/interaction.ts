@@ -3,25 +3,26 @@
 // orbiting only on the right button or with Alt, and the selection's shortcuts.
 import * as THREE from 'three';
 import { Brush } from './brush';
-import { Rect, verticesInRect } from './boxselect';
-import { Mirror, mirror, mirrored } from './mirror';
+import { Point, corners, inPath, inRect, rectBetween, showRegion, verticesIn } from './boxselect';
+import { XMirror } from './mirror';
 import { EditorState, FIXED, FREE } from './state';
 import { Mode, ModalTransform } from './transform';
 
 export type Tool = 'handle' | 'fixed' | 'erase' | 'move' | 'pin';
-// Rotations and scales turn about the active group's centroid (Blender's median point) or the
-// 3D cursor.
-export type PivotMode = 'median' | 'cursor';
+// Rotations and scales turn about the active group's centroid (Blender's median point), the
+// 3D cursor, or (G, R, S only) every movable group about its own centroid.
+export type PivotMode = 'median' | 'cursor' | 'individual';
 
 // How long the pointer rests before the full detail is asked for in place of the preview (ms).
 const kRestMs = 200;
 
 interface Drag {
   group: number;
-  start: THREE.Vector3; // the handle point grabbed (mouse) or the gizmo's start
+  start: THREE.Vector3; // the handle point grabbed (mouse), the gizmo's start or the pivot (G, R, S)
   transform: THREE.Matrix4; // the group's at the start
   pivot?: THREE.Matrix4; // the gizmo's at the start
   modal?: ModalTransform; // G, R or S from the keyboard
+  others?: { group: number; transform: THREE.Matrix4; modal: ModalTransform }[]; // individual pivots
 }
 
 export class Interaction {
@@ -39,11 +40,11 @@ export class Interaction {
   pivotMode: PivotMode = 'median';
   cursor: THREE.Vector3 | null = null; // the 3D cursor
   private topology: { indices: Uint32Array; brush: Brush } | null = null;
-  xMirror = false; // paint both sides of the middle x plane; a group's counterpart moves mirrored
-  private symmetry: { rest: Float32Array; mirror: Mirror } | null = null;
-  private partner = new Map<number, number>(); // handle group -> its mirror image's group
-  private box: { armed: boolean; from: { x: number; y: number } | null } = { armed: false, from: null }; // B
-  xray = false; // box selection through the surface
+  readonly xMirror = new XMirror();
+  // B arms a box (drawn with the left button); Ctrl + right-drag draws a lasso.
+  private region: { armed: boolean; lasso: boolean; path: Point[] } = { armed: false, lasso: false, path: [] };
+  xray = false; // box and lasso select through the surface
+  private linkedArmed = false; // the Linked button: the next click picks the piece
 
   constructor(private readonly s: EditorState, private readonly view: HTMLElement) {
     const v = s.viewer;
@@ -90,9 +91,17 @@ export class Interaction {
       return;
     }
     if (e.button === 2 && e.shiftKey) this.cursorPress = { x: e.clientX, y: e.clientY };
-    if (this.box.armed && e.button === 0 && e.target === v.canvas) {
+    if (this.linkedArmed && e.button === 0 && e.target === v.canvas) {
       e.stopPropagation();
-      this.box.from = { x: e.clientX, y: e.clientY };
+      this.linkedArmed = false;
+      this.showHeader('');
+      this.pointer = { x: e.clientX, y: e.clientY };
+      return this.selectTopology('linked');
+    }
+    const lasso = e.button === 2 && e.ctrlKey && this.s.editable;
+    if (e.target === v.canvas && ((this.region.armed && e.button === 0) || lasso)) {
+      e.stopPropagation();
+      this.region = { armed: true, lasso, path: [{ x: e.clientX, y: e.clientY }] };
       this.view.setPointerCapture(e.pointerId);
       return;
     }
@@ -145,7 +154,11 @@ export class Interaction {
     const v = this.s.viewer;
     this.pointer = { x: e.clientX, y: e.clientY };
     if (this.drag?.modal) return this.modalMoved();
-    if (this.box.from) return this.showBox(this.boxRect(this.box.from, this.pointer));
+    const r = this.region;
+    if (r.path.length > 0) {
+      if (r.lasso) r.path.push({ ...this.pointer });
+      return showRegion(this.view, r.lasso ? r.path : corners(rectBetween(r.path[0], this.pointer)));
+    }
     if (this.stroke) return this.paintAt(e.clientX, e.clientY);
     if (this.drag && !this.drag.pivot) {
       const p = v.onViewPlane(e.clientX, e.clientY, this.drag.start);
@@ -163,8 +176,9 @@ export class Interaction {
     this.cursorPress = null;
     if (press && e.button === 2 && Math.hypot(e.clientX - press.x, e.clientY - press.y) < 5) this.placeCursor(e.clientX, e.clientY);
     if (this.drag?.modal) return;
-    if (this.box.from && e.button === 0) {
-      this.endBox(this.boxRect(this.box.from, { x: e.clientX, y: e.clientY }));
+    const r = this.region;
+    if (r.path.length > 0 && e.button === (r.lasso ? 2 : 0)) {
+      this.endRegion(r.lasso ? inPath(r.path) : inRect(rectBetween(r.path[0], { x: e.clientX, y: e.clientY })));
       return;
     }
     this.s.viewer.orbit.enabled = true;
@@ -205,7 +219,7 @@ export class Interaction {
       if (stroke) {
         const labels = this.s.labels;
         const changed: number[] = [];
-        const paired = this.xMirror && stroke.pin === null ? this.mirrored(vertices, stroke.label) : [];
+        const paired = this.xMirror.on && stroke.pin === null ? this.xMirror.paired(this.s, vertices, stroke.label) : [];
         for (const [v, label] of [...Array.from(vertices, (v) => [v, stroke.label]), ...paired]) {
           // A pin stroke claims free, fixed and handle vertices; other tools leave pins alone
           // except Erase.
@@ -272,39 +286,8 @@ export class Interaction {
 
   // ------------------------------------------------------------ dragging
 
-  // The counterparts of painted vertices with their label: a handle's go to the group that
-  // mirrors it (made on first use).
-  private mirrored(vertices: Uint32Array, label: number): [number, number][] {
-    const s = this.s;
-    if (this.symmetry?.rest !== s.rest) this.symmetry = { rest: s.rest, mirror: mirror(s.rest, s.ready?.diagonal ?? 1) };
-    const m = this.symmetry.mirror;
-    let target = label;
-    if (label >= 2) {
-      const g = label - 2;
-      let p = this.partner.get(g);
-      if (p === undefined || !s.groups[p] || s.groups[p].pinned) {
-        s.groups.push({ transform: mirrored(s.groups[g].transform, m), pinned: false });
-        p = s.groups.length - 1;
-        this.partner.set(g, p);
-        this.partner.set(p, g);
-      }
-      target = 2 + p;
-    }
-    const out: [number, number][] = [];
-    for (const v of vertices) if (m.of[v] >= 0 && m.of[v] !== v) out.push([m.of[v], target]);
-    return out;
-  }
-
-  // The mirrored group follows its counterpart's transform.
-  private followMirror(g: number): void {
-    const p = this.partner.get(g);
-    if (this.xMirror && p !== undefined && this.s.groups[p] && this.symmetry) {
-      this.s.groups[p].transform = mirrored(this.s.groups[g].transform, this.symmetry.mirror);
-    }
-  }
-
   private dragged(): void {
-    if (this.drag) this.followMirror(this.drag.group);
+    if (this.drag) this.xMirror.follow(this.s.groups, this.drag.group);
     const preview = this.s.previewWanted;
     this.usedPreview ||= preview;
     this.s.sendFrame(preview);
@@ -342,8 +325,11 @@ export class Interaction {
       this.showHeader('');
       this.s.viewer.orbit.enabled = true;
     }
-    if (!keep) this.s.groups[d.group].transform = d.transform;
-    this.followMirror(d.group);
+    if (!keep) {
+      this.s.groups[d.group].transform = d.transform;
+      for (const o of d.others ?? []) this.s.groups[o.group].transform = o.transform;
+    }
+    this.xMirror.follow(this.s.groups, d.group);
     if (this.usedPreview || !keep) this.s.sendFrame(false);
     if (keep) this.s.commit();
     this.placeGizmo();
@@ -433,8 +419,13 @@ export class Interaction {
     }
     const diagonal = s.ready?.diagonal ?? 1;
     const step = 10 ** Math.floor(Math.log10(diagonal / 20)); // Ctrl snaps a move to this
-    const modal = new ModalTransform(mode, pivot, group.transform.clone(), { ...this.pointer }, s.viewer, step);
-    this.drag = { group: g, start: pivot, transform: group.transform.clone(), modal };
+    const modalOf = (k: number, at: THREE.Vector3) =>
+      new ModalTransform(mode, at, s.groups[k].transform.clone(), { ...this.pointer }, s.viewer, step);
+    const others = this.pivotMode !== 'individual' ? [] : s.groups.flatMap((x, k) => {
+      const c = k !== g && !x.pinned ? this.restCentroid(k) : null;
+      return c ? [{ group: k, transform: x.transform.clone(), modal: modalOf(k, c.applyMatrix4(x.transform)) }] : [];
+    });
+    this.drag = { group: g, start: pivot, transform: group.transform.clone(), modal: modalOf(g, pivot), others };
     this.usedPreview = false;
     s.viewer.gizmo.detach();
     s.viewer.orbit.enabled = false;
@@ -465,7 +456,13 @@ export class Interaction {
 
   private modalMoved(): void {
     const d = this.drag!;
-    this.s.groups[d.group].transform = d.modal!.matrix(this.pointer);
+    const m = d.modal!;
+    this.s.groups[d.group].transform = m.matrix(this.pointer);
+    for (const o of d.others ?? []) {
+      // The same axis, value and snapping, each about its own centroid and along its own axes.
+      Object.assign(o.modal, { lock: m.lock && { ...m.lock }, typed: m.typed, snap: m.snap });
+      this.s.groups[o.group].transform = o.modal.matrix(this.pointer);
+    }
     this.showHeader(d.modal!.readout(this.pointer));
     this.dragged();
   }
@@ -485,40 +482,34 @@ export class Interaction {
     return this.topology.brush;
   }
 
+  // The Linked button: the next left click selects the piece under it (L does it at once).
+  armLinked(): void {
+    if (!this.s.editable || this.stroke || this.drag) return;
+    this.linkedArmed = true;
+    this.showHeader('Select linked: click the piece to select; Esc cancels');
+  }
+
   // B: the next left drag draws a rectangle; its vertices get the tool's label.
   armBox(): void {
     if (!this.s.editable || this.stroke || this.drag) return;
-    this.box.armed = true;
+    this.region = { armed: true, lasso: false, path: [] };
     this.showHeader(`Box select (${this.xray ? 'X-ray: through the surface' : 'visible vertices only'}): ` +
       'drag a rectangle with the left button; Esc cancels');
   }
 
-  private boxRect(a: { x: number; y: number }, b: { x: number; y: number }): Rect {
-    return { left: Math.min(a.x, b.x), top: Math.min(a.y, b.y), right: Math.max(a.x, b.x), bottom: Math.max(a.y, b.y) };
-  }
-
-  private showBox(r: Rect | null): void {
-    const box = document.getElementById('box')!;
-    box.hidden = r === null;
-    if (!r) return;
-    const view = this.view.getBoundingClientRect();
-    Object.assign(box.style, { left: `${r.left - view.left}px`, top: `${r.top - view.top}px`,
-      width: `${r.right - r.left}px`, height: `${r.bottom - r.top}px` });
-  }
-
-  // Ends the box (null: cancelled).
-  endBox(r: Rect | null): boolean {
-    if (!this.box.armed) return false;
-    this.box = { armed: false, from: null };
-    this.showBox(null);
+  // Ends the box or lasso, selecting what `contains` (null: cancelled); returns whether one was on.
+  private endRegion(contains: ((x: number, y: number) => boolean) | null): boolean {
+    if (!this.region.armed) return false;
+    this.region = { armed: false, lasso: false, path: [] };
+    showRegion(this.view, null);
     this.showHeader('');
-    if (!r) return true;
+    if (!contains) return true;
     const label = this.toolLabel();
     if (label === null) {
       this.s.note('Pin paints one pinned region per stroke: pick Handle, Fixed or Erase');
       return true;
     }
-    this.relabel(verticesInRect(this.s.viewer, r, this.xray, this.s.ready?.diagonal ?? 1), () => label, label);
+    this.relabel(verticesIn(this.s.viewer, contains, this.xray, this.s.ready?.diagonal ?? 1), () => label, label);
     return true;
   }
 
@@ -580,7 +571,12 @@ export class Interaction {
 
   // Escape: cancels a drag or a stroke; returns whether there was one.
   cancel(): boolean {
-    if (this.endBox(null)) return true;
+    if (this.endRegion(null)) return true;
+    if (this.linkedArmed) {
+      this.linkedArmed = false;
+      this.showHeader('');
+      return true;
+    }
     if (this.drag) {
       const gizmo = this.drag.pivot !== undefined;
       const modal = this.drag.modal !== undefined;

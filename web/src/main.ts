@@ -37,6 +37,7 @@ const viewer = state.viewer;
   cameraTarget: () => viewer.orbit.target.toArray(),
   measures: () => state.measures,
   cursor: () => interaction.cursor?.toArray() ?? null,
+  gizmoOnScreen: () => (viewer.gizmo.object ? viewer.toScreen(viewer.pivot.position) : null),
   setView: (direction: [number, number, number], zoom = 1) => {
     const target = viewer.orbit.target;
     const distance = viewer.camera.position.distanceTo(target) / zoom;

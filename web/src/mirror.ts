@@ -1,8 +1,9 @@
 // X-mirror symmetry across the plane x = c through the middle of the bounding box: each
 // vertex's counterpart (the nearest vertex to its mirror image, within 2% of the diagonal:
 // exact on symmetric meshes, near on scanned ones; none where nothing is near), and a handle group's transform mirrored for
-// its counterpart group.
+// its counterpart group; XMirror, the editor's switch, pairs the groups.
 import * as THREE from 'three';
+import type { EditorState, Group } from './state';
 
 export interface Mirror {
   flip: THREE.Matrix4; // the reflection x -> 2c - x
@@ -46,4 +47,39 @@ export function mirror(rest: Float32Array, diagonal: number): Mirror {
     }
   }
   return { flip: new THREE.Matrix4().set(-1, 0, 0, 2 * c, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1), of: out };
+}
+
+// The X mirror of painting and moves: a painted handle's counterparts go to a group of their
+// own (made on first use, paired in this page only), which moves mirrored.
+export class XMirror {
+  on = false;
+  private symmetry: { rest: Float32Array; mirror: Mirror } | null = null;
+  private partner = new Map<number, number>(); // handle group -> its mirror image's group
+
+  // The counterparts of painted vertices with the label each gets.
+  paired(s: EditorState, vertices: Uint32Array, label: number): [number, number][] {
+    if (this.symmetry?.rest !== s.rest) this.symmetry = { rest: s.rest, mirror: mirror(s.rest, s.ready?.diagonal ?? 1) };
+    const m = this.symmetry.mirror;
+    let target = label;
+    if (label >= 2) {
+      const g = label - 2;
+      let p = this.partner.get(g);
+      if (p === undefined || !s.groups[p] || s.groups[p].pinned) {
+        s.groups.push({ transform: mirrored(s.groups[g].transform, m), pinned: false });
+        p = s.groups.length - 1;
+        this.partner.set(g, p);
+        this.partner.set(p, g);
+      }
+      target = 2 + p;
+    }
+    const out: [number, number][] = [];
+    for (const v of vertices) if (m.of[v] >= 0 && m.of[v] !== v) out.push([m.of[v], target]);
+    return out;
+  }
+
+  // Group g's counterpart takes the mirror image of its transform.
+  follow(groups: Group[], g: number): void {
+    const p = this.partner.get(g);
+    if (this.on && p !== undefined && groups[p] && this.symmetry) groups[p].transform = mirrored(groups[g].transform, this.symmetry.mirror);
+  }
 }

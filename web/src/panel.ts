@@ -133,9 +133,8 @@ export class Panel {
       if (this.ui.pivotMode === 'cursor' && !this.ui.cursor) s.note('Shift+right-click on the surface places the 3D cursor');
       this.ui.placeGizmo();
     });
-    $('select-linked').addEventListener('click', () =>
-      s.note('point at the piece and press L (the button cannot know where you point)'));
-    $('x-mirror').addEventListener('change', (e) => (this.ui.xMirror = (e.target as HTMLInputElement).checked));
+    $('select-linked').addEventListener('click', () => this.ui.armLinked());
+    $('x-mirror').addEventListener('change', (e) => (this.ui.xMirror.on = (e.target as HTMLInputElement).checked));
     $('select-box').addEventListener('click', () => this.ui.armBox());
     $('xray').addEventListener('change', (e) => (this.ui.xray = (e.target as HTMLInputElement).checked));
     $('select-invert').addEventListener('click', () => this.ui.selectTopology('invert'));
