@@ -2,16 +2,12 @@
 # Regenerates docs/results/: the paper's Table 1, Fig. 5 and Fig. 6 measured on this machine,
 # pictures of the pipeline (original, smooth base, deformed base, detailed result), all with the
 # paper's linear energy; the linear energy, spectral ARAP and CGAL's SR-ARAP on scenes that turn
-<<<<<<< HEAD
-# (tables and pictures); the intrinsic Delaunay Laplacian against the cotan one on every
-# shared model; and the exact and the multilevel basis on subdivided meshes up to 2.77M vertices.
-=======
-# (tables and pictures); the Blender add-on against Blender's Laplacian Deform; and the intrinsic
-# Delaunay Laplacian against the cotan one on every shared model.
->>>>>>> main
+# (tables and pictures); the Blender add-on against Blender's Laplacian Deform; the intrinsic
+# Delaunay Laplacian against the cotan one on every shared model; and the exact and the
+# multilevel basis on subdivided meshes up to 2.77M vertices.
 # Needs ../shared/meshes (the test meshes) and a build (scripts/setup.sh); installs
 # python3-matplotlib for the plot, chromium for the pictures and blender where missing.
-# Usage: scripts/reproduce.sh [OUT]     (default: docs/results; takes about 30 minutes)
+# Usage: scripts/reproduce.sh [OUT]     (default: docs/results; takes about 45 minutes)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-docs/results}
