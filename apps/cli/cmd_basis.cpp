@@ -58,7 +58,7 @@ void add_basis_command(CLI::App& app) {
       j["solves"] = h.solves;
       j["eigenvalues"] = std::vector<double>(h.eigenvalues.begin(), h.eigenvalues.end());
       j["residuals"] = std::vector<double>(h.residuals.begin(), h.residuals.end());
-      std::cout << j.dump() << "\n";
+      std::cout << json_text(j) << "\n";
     } else {
       std::cout << h.eigenvalues.size()
                 << (h.approximate ? " approximate (multilevel) eigenpairs of " : " eigenpairs of ")

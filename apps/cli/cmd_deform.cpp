@@ -104,7 +104,7 @@ void add_deform_command(CLI::App& app) {
       j["timings"] = timings;
       j["constraint_error"] = {{"max", e.max}, {"rms", e.rms}};
       j["output"] = args->output;
-      std::cout << j.dump() << "\n";
+      std::cout << json_text(j) << "\n";
     } else {
       std::cout << "wrote " << args->output << ": frame " << frame.total * 1e3
                 << " ms, constraint error max " << e.max << " rms " << e.rms

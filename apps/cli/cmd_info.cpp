@@ -36,6 +36,7 @@ void add_info_command(CLI::App& app) {
     j["bbox_diagonal"] = i.bbox_diagonal;
     j["non_manifold_edges"] = i.non_manifold_edges;
     j["degenerate_faces"] = i.degenerate_faces;
+    j["duplicate_faces"] = i.duplicate_faces;
     // Defects, their first vertex in the file's numbering (null: none).
     const auto file_vertex = [&](int v) {
       return v < 0 ? nlohmann::ordered_json()
@@ -64,8 +65,7 @@ void add_info_command(CLI::App& app) {
     j["file_faces"] = loaded.info.file_faces;
     j["welded_corners"] = loaded.info.welded_corners;
     const auto text = [](const nlohmann::ordered_json& v) {
-      return v.is_string() ? v.get<std::string>()
-                           : v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+      return v.is_string() ? v.get<std::string>() : json_text(v);
     };
     if (json) {
       std::cout << text(j) << "\n";

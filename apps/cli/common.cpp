@@ -150,6 +150,10 @@ ProgressCallback progress_bar(const std::string& label) {
   };
 }
 
+std::string json_text(const nlohmann::ordered_json& j, int indent) {
+  return j.dump(indent, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+}
+
 void add_eigensolver_option(CLI::App& cmd, EigenSolver& solver) {
   static const auto kSolver =
       by_name({EigenSolver::BlockKrylov, EigenSolver::Lanczos, EigenSolver::Multilevel});
@@ -185,7 +189,7 @@ void TableOutputs::add_to(CLI::App& cmd) {
 }
 
 void TableOutputs::write(const nlohmann::ordered_json& rows, const std::string& table) const {
-  if (!json.empty()) write_file_atomically(json, rows.dump(2) + "\n");
+  if (!json.empty()) write_file_atomically(json, json_text(rows, 2) + "\n");
   if (!markdown.empty()) write_file_atomically(markdown, table);
   std::cout << table;
 }

@@ -36,6 +36,10 @@ LoadedMesh load_mesh(const std::string& path);
 // A progress bar on stderr when it is a terminal; nothing otherwise.
 ProgressCallback progress_bar(const std::string& label);
 
+// JSON text for stdout or a file; bytes that are not UTF-8 (a file name) become U+FFFD, so the
+// text stays valid JSON.
+std::string json_text(const nlohmann::ordered_json& j, int indent = -1);
+
 // Adds --eigensolver krylov|lanczos|multilevel to `cmd`, bound to `solver`.
 void add_eigensolver_option(CLI::App& cmd, EigenSolver& solver);
 

@@ -31,7 +31,7 @@ int fail(const CLI::App& app, int argc, char** argv, int code, const char* prefi
                                  [](const char* a) { return std::strcmp(a, "--json") == 0; });
   if (asked) {
     const nlohmann::ordered_json j = {{"error", message}, {"exit_code", code}};
-    std::cout << j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
+    std::cout << specdeform::cli::json_text(j) << std::endl;
   }
   return code;
 }

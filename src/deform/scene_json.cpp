@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <numeric>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
@@ -139,8 +140,20 @@ class Field {
 };
 
 Json parse_json(std::string_view text, const std::string& where) {
+  // A key given twice in one object would silently take the last value: refused.
+  std::vector<std::set<std::string>> keys;
+  const auto unique_keys = [&](int, Json::parse_event_t event, Json& parsed) {
+    if (event == Json::parse_event_t::object_start) keys.emplace_back();
+    if (event == Json::parse_event_t::object_end) keys.pop_back();
+    if (event == Json::parse_event_t::key &&
+        !keys.back().insert(parsed.get<std::string>()).second) {
+      throw InputError(where + ": the key \"" + parsed.get<std::string>() +
+                       "\" appears twice in one object");
+    }
+    return true;
+  };
   try {
-    return Json::parse(text);
+    return Json::parse(text, unique_keys);
   } catch (const Json::parse_error& e) {
     const std::string_view read = text.substr(0, std::min(text.size(), e.byte));
     const size_t line_start = read.rfind('\n') + 1;  // 0 on the first line

@@ -2,10 +2,19 @@
 
 #include <string>
 
+#include <Eigen/Geometry>
+
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/mesh_info.h"
 
 namespace specdeform {
+
+namespace {
+
+// The farthest a target may lie from its vertex, in sizes of the constrained region.
+constexpr double kLargestMove = 1e6;
+
+}  // namespace
 
 ConstrainedSet constrained_set(const Selection& selection, const TriangleMesh& mesh,
                                UnconstrainedPieces pieces, const std::vector<int>& file_index) {
@@ -86,11 +95,28 @@ Eigen::MatrixX3d constraint_targets(const ConstrainedSet& set, const Eigen::Matr
       throw InputError("deformation: the transform of handle group " + std::to_string(g) +
                        " is singular");
     }
+    if (det < 0.0) {
+      throw InputError("deformation: the transform of handle group " + std::to_string(g) +
+                       " mirrors the handle (negative determinant); a deformation cannot "
+                       "reflect part of a surface");
+    }
   }
+  // Targets far beyond the constrained region's size (a translation of 1e300, say) would give
+  // overflowing or meaningless results: refused.
   Eigen::MatrixX3d targets(set.vertices.size(), 3);
+  Eigen::AlignedBox3d box;
+  double moved = 0.0;
   for (size_t i = 0; i < set.vertices.size(); ++i) {
     const Eigen::Vector3d p = positions.row(set.vertices[i]);
     targets.row(i) = set.group[i] < 0 ? p : Eigen::Vector3d(transforms[set.group[i]] * p);
+    box.extend(p);
+    moved = std::max(moved, (targets.row(i).transpose() - p).norm());
+  }
+  const double size = set.vertices.empty() ? 0.0 : std::max(box.diagonal().norm(), 1e-300);
+  if (!(moved <= kLargestMove * size)) {
+    throw InputError("deformation: a handle moves its vertices " + std::to_string(moved) +
+                     ", more than " + std::to_string(static_cast<long>(kLargestMove)) +
+                     " times the size of the constrained region");
   }
   return targets;
 }

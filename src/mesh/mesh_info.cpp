@@ -1,6 +1,7 @@
 #include "specdeform/mesh/mesh_info.h"
 
 #include <algorithm>
+#include <array>
 #include <numeric>
 #include <tuple>
 #include <utility>
@@ -66,6 +67,13 @@ MeshInfo compute_mesh_info(const TriangleMesh& mesh) {
     }
   }
   std::sort(half.begin(), half.end());
+  std::vector<std::array<int, 3>> corners(info.faces);
+  for (int f = 0; f < info.faces; ++f) {
+    corners[f] = {F(f, 0), F(f, 1), F(f, 2)};
+    std::sort(corners[f].begin(), corners[f].end());
+  }
+  std::sort(corners.begin(), corners.end());
+  for (size_t f = 1; f < corners.size(); ++f) info.duplicate_faces += corners[f] == corners[f - 1];
   const Eigen::VectorXi component = vertex_components(mesh, &info.components);
   std::vector<char> misoriented(info.components, 0);
   // Corner 3 f + k is face f at vertex F(f, k). Faces that share an edge join their corners at

@@ -55,6 +55,30 @@ expect 1 "$bin" deform "$tmp/p.off" --sel "$tmp/short.sel" --def "$tmp/p.def" -o
 printf '{"handles": [{"vertices": [9999]}]}' >"$tmp/bad.json"
 expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/bad.json" -o "$tmp/x.off"
 expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/scene.json" --constraints hard -m 3 -o "$tmp/x.off"
+# Bad numbers and names (issue 26): each a clear error and no output, or valid JSON.
+no_output() {  # no_output FILE: the last command wrote no FILE
+  [ -e "$1" ] && { echo "FAIL: $1 written despite an error"; fails=$((fails + 1)); rm -f "$1"; }
+}
+printf '# far\n1 0 0 1e300\n0 1 0 0\n0 0 1 0\n0 0 0 1\n' >"$tmp/far.def"
+expect 1 "$bin" deform "$tmp/p.off" --sel "$tmp/p.sel" --def "$tmp/far.def" -m 30 -o "$tmp/x.off"
+check_error "more than 1000000 times the size of the constrained region"
+no_output "$tmp/x.off"
+printf '{"handles": [{"vertices": [288], "transform": {"translate": [0, 0, 0.2]}}], "fixed": [0], "fixed": [1]}' >"$tmp/twice.json"
+expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/twice.json" -m 30 -o "$tmp/x.off"
+check_error 'the key "fixed" appears twice in one object'
+no_output "$tmp/x.off"
+printf '{"handles": [{"vertices": [288], "transform": {"scale": -1}}], "fixed": [0, 1, 2, 16]}' >"$tmp/mirror.json"
+expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/mirror.json" -m 30 -o "$tmp/x.off"
+check_error "mirrors the handle (negative determinant)"
+no_output "$tmp/x.off"
+odd=$(printf '%s/d\377\376.off' "$tmp")
+expect 0 "$bin" deform "$tmp/p.off" --scene "$tmp/scene.json" -m 30 -o "$odd" --json
+/usr/bin/python3 -m json.tool "$tmp/out" >/dev/null || { echo "FAIL: --json with a non-UTF-8 name is not valid JSON"; fails=$((fails + 1)); }
+faces=$(sed -n 2p "$tmp/p.off" | awk '{print $2}')
+awk -v f="$faces" 'NR==2{$2=f+1} {print} END{}' "$tmp/p.off" >"$tmp/dup.off"
+tail -1 "$tmp/p.off" >>"$tmp/dup.off"
+expect 0 "$bin" info "$tmp/dup.off" --json
+grep -q '"duplicate_faces":1' "$tmp/out" || { echo "FAIL: info does not report the duplicated face: $(cat "$tmp/out")"; fails=$((fails + 1)); }
 # A scene that names its mesh, read without MESH.
 printf '{"mesh": "p.off", "handles": [{"vertices": [288], "transform": {"translate": [0, 0, 0.2]}}], "fixed": [0, 1]}' >"$tmp/named.json"
 expect 0 "$bin" deform --scene "$tmp/named.json" -m 30 -o "$tmp/named.off"

@@ -45,8 +45,9 @@ ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi
                                const std::vector<int>& file_index = {});
 
 // Target position of every constrained vertex (|C| x 3): the group's transform applied to
-// `positions` (fixed vertices keep theirs). Throws InputError for a wrong number of transforms
-// or a non-finite or singular transform.
+// `positions` (fixed vertices keep theirs). Throws InputError for a wrong number of transforms,
+// a non-finite, singular or mirroring (negative determinant) transform, or a target more than a
+// million times the constrained region's size from its vertex.
 Eigen::MatrixX3d constraint_targets(const ConstrainedSet& set, const Eigen::MatrixX3d& positions,
                                     const std::vector<Eigen::Affine3d>& transforms);
 

@@ -17,6 +17,7 @@ struct MeshInfo {
   int components = 0;            // connected through shared vertices
   int euler_characteristic = 0;  // V - E + F
   int degenerate_faces = 0;      // see is_degenerate_triangle
+  int duplicate_faces = 0;       // the same three vertices as a lower-numbered face, any order
   // Defects that later steps refuse (a vertex without area has no mass) or that matter (the
   // deformation's normals and frames assume one orientation per component):
   int zero_area_vertices = 0;      // touched only by degenerate faces (or by none)
