@@ -43,6 +43,7 @@ void add_basis_command(CLI::App& app) {
       nlohmann::ordered_json j;
       j["vertices"] = loaded.mesh.num_vertices();
       j["modes"] = h.eigenvalues.size();
+      j["pieces"] = h.pieces;  // solved one by one when several: modes may exceed -m
       j["laplacian"] = name(h.laplacian);
       j["seconds"] = seconds;
       j["converged"] = converged;
@@ -62,8 +63,11 @@ void add_basis_command(CLI::App& app) {
     } else {
       std::cout << h.eigenvalues.size()
                 << (h.approximate ? " approximate (multilevel) eigenpairs of " : " eigenpairs of ")
-                << loaded.mesh.num_vertices() << " vertices in " << seconds << " s (residual "
-                << h.max_residual << ", orthonormality " << h.max_orthogonality_error << ")\n"
+                << loaded.mesh.num_vertices() << " vertices"
+                << (h.pieces > 1 ? " (" + std::to_string(h.pieces) + " pieces, each solved alone)"
+                                 : std::string())
+                << " in " << seconds << " s (residual " << h.max_residual << ", orthonormality "
+                << h.max_orthogonality_error << ")\n"
                 << "eigenvalues " << h.eigenvalues[0] << " ... "
                 << h.eigenvalues[h.eigenvalues.size() - 1] << "\n";
       if (!args->output.empty()) std::cout << "wrote " << args->output << "\n";

@@ -90,8 +90,10 @@ void add_deform_command(CLI::App& app) {
       j["modes"] = options.solver == DeformSolver::Spectral ? modes : 0;
       j["basis_cached"] = loaded_basis;
       j["basis_approximate"] = deformer.basis() && deformer.basis()->approximate;
-      j["constrained_vertices"] = constrained.first_held;
-      j["held_pieces"] = constrained.held_pieces;
+      j["constrained_vertices"] = constrained.first_free;
+      j["free_pieces"] = constrained.free_pieces;
+      j["unconstrained"] = name(options.unconstrained);
+      j["constrained_piece_modes"] = deformer.constrained_piece_modes();
       j["energy"] = name(options.energy);
       if (options.energy == DeformEnergy::Arap) {
         j["iterations"] = arap.iterations;
@@ -113,9 +115,11 @@ void add_deform_command(CLI::App& app) {
         std::cout << "; ARAP " << arap.iterations << " iterations, last relative energy change "
                   << arap.relative_change << (arap.converged ? "" : " (not converged)");
       }
-      if (constrained.held_pieces > 0) {
-        std::cout << "; " << constrained.held_pieces
-                  << " pieces without handle or fixed vertex held in place";
+      if (constrained.free_pieces > 0) {
+        std::cout << "; " << constrained.free_pieces << " pieces without handle or fixed vertex "
+                  << (options.unconstrained == UnconstrainedPieces::Follow
+                          ? "moved with the surface around them"
+                          : "held in place");
       }
       std::cout << "\n";
     }

@@ -57,6 +57,8 @@ void DeformArgs::add_to(CLI::App& cmd) {
                                         DetailMethod::Frames, DetailMethod::Transfer});
   static const auto kSolvers = by_name({DeformSolver::Spectral, DeformSolver::Spatial});
   static const auto kConstraints = by_name({ConstraintMode::Soft, ConstraintMode::Hard});
+  static const auto kPieces =
+      by_name({UnconstrainedPieces::Follow, UnconstrainedPieces::Keep, UnconstrainedPieces::Error});
   const DeformOptions defaults;
   const auto fallback = [](auto value) {
     std::ostringstream s;
@@ -100,6 +102,11 @@ void DeformArgs::add_to(CLI::App& cmd) {
   cmd.add_option("--constraints", options.constraints,
                  "soft | hard" + fallback(name(defaults.constraints)))
       ->transform(CLI::CheckedTransformer(kConstraints, CLI::ignore_case));
+  cmd.add_option("--unconstrained", options.unconstrained,
+                 "pieces without handle or fixed vertex: follow (the surface around them) | "
+                 "keep | error" +
+                     fallback(name(defaults.unconstrained)))
+      ->transform(CLI::CheckedTransformer(kPieces, CLI::ignore_case));
 }
 
 DeformOptions DeformArgs::merged(const CLI::App& cmd, const DeformOptions& scene) const {
@@ -117,6 +124,7 @@ DeformOptions DeformArgs::merged(const CLI::App& cmd, const DeformOptions& scene
   if (flag("--detail")) o.detail = options.detail;
   if (flag("--solver")) o.solver = options.solver;
   if (flag("--constraints")) o.constraints = options.constraints;
+  if (flag("--unconstrained")) o.unconstrained = options.unconstrained;
   return o;
 }
 

@@ -644,7 +644,10 @@ void EditorSession::send_state() {
                      {"redo", s.at + 1 < s.history.size()},
                      {"selection_seconds", s.selection_seconds},
                      {"pin_error", s.pin_error},
-                     {"held_pieces", s.has_handles ? s.deformer->held_pieces() : 0},
+                     {"free_pieces", s.has_handles ? s.deformer->free_pieces() : 0},
+                     {"unconstrained", name(s.options.unconstrained)},
+                     {"constrained_piece_modes",
+                      s.has_handles ? s.deformer->constrained_piece_modes() : std::vector<int>()},
                      {"pose", s.pose}}));
 }
 

@@ -24,7 +24,8 @@
 //      "setup": {...}, "arap_clusters"}         after a mesh message or a settings request
 //     {"type": "state", "request": the request's type ("open": the server's first mesh),
 //      "groups": [{"vertices", "pinned", "transform": 16 numbers}], "fixed",
-//      "undo", "redo", "selection_seconds", "pin_error", "held_pieces", "pose"}
+//      "undo", "redo", "selection_seconds", "pin_error", "free_pieces", "unconstrained",
+//      "constrained_piece_modes", "pose"}
 //                                               after every edit, last (its frame comes first)
 //     {"type": "empty", "request"}              no mesh is open (a failed or cancelled start)
 //     {"type": "error", "message": one line, "request": the request's type, "cancelled": b}

@@ -169,7 +169,7 @@ class SpectralDeformer:
         detail: Literal["none", "displacement", "frames", "transfer"] = ...,
         solver: Literal["spectral", "spatial"] = ...,
         constraints: Literal["soft", "hard"] = ...,
-        unconstrained: Literal["keep", "error"] = ...,
+        unconstrained: Literal["follow", "keep", "error"] = ...,
         float32_basis: bool = ...,
         iterations: int = ...,
         clusters: int = ...,

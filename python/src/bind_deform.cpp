@@ -133,7 +133,7 @@ eigenpairs (copied); mass, cache, progress, tolerance: as manifold_harmonics tak
 the basis is computed here. With solver="spatial" and no basis, the base is the mesh itself.
 Keywords: the deformation options (energy="linear"|"arap", ks, kb, constraint_weight,
 detail="none"|"displacement"|"frames"|"transfer", solver="spectral"|"spatial",
-constraints="soft"|"hard", unconstrained="keep"|"error", float32_basis, and for ARAP
+constraints="soft"|"hard", unconstrained="follow"|"keep"|"error", float32_basis, and for ARAP
 iterations, clusters, arap_tolerance, arap_bending, history, warm_start).)")
       .def(
           "set_selection",
@@ -233,13 +233,15 @@ vertices held in place. A vertex may belong to one group only.)")
             r["relative_change"] = a.relative_change;
             r["converged"] = a.converged;
             r["clusters"] = d.deformer->rotation_clusters();
-            r["held_pieces"] = d.deformer->held_pieces();
+            r["free_pieces"] = d.deformer->free_pieces();
+            r["constrained_piece_modes"] = d.deformer->constrained_piece_modes();
             return r;
           },
           R"(The last solve: ARAP's iterations (of which L-BFGS steps: quasi_newton_steps), its energy
 and last relative change, whether it converged (the linear energy: 0 iterations, converged),
-the rotation clusters, and held_pieces (components without a handle or fixed vertex, held in
-place by the last selection).)");
+the rotation clusters, and free_pieces (components without a handle or fixed vertex in the last
+selection: they follow the surface around them, or are held in place, as `unconstrained` says)
+and constrained_piece_modes (the basis's modes on each piece with a constrained vertex).)");
 
   m.def("_read_scene", &read_scene_files, py::arg("path"), py::arg("mesh"),
         py::arg("transforms") = py::none());

@@ -47,11 +47,13 @@ std::shared_ptr<const ManifoldHarmonics> copied_basis(py::handle evals, py::hand
   return h;
 }
 
-// The first `modes` pairs of `h` (h itself when that is all of them).
+// The first `modes` pairs of `h` (h itself when that is all of them, or the m it was computed
+// piece by piece for).
 std::shared_ptr<const ManifoldHarmonics> first_modes(std::shared_ptr<const ManifoldHarmonics> h,
                                                      int modes, const std::string& name) {
   const Eigen::Index m = h->basis.cols();
   if (modes < 1) throw InputError(name + ": " + std::to_string(modes) + " modes asked for");
+  if (h->pieces > 1 && modes == h->requested_modes) return h;
   if (modes > m) {
     throw InputError(name + ": holds " + std::to_string(m) + " frequencies, " +
                      std::to_string(modes) + " are asked for");

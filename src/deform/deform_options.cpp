@@ -15,7 +15,7 @@ constexpr std::array<std::string_view, 2> kConstraintModes = {"soft", "hard"};
 constexpr std::array<std::string_view, 2> kSolvers = {"spectral", "spatial"};
 constexpr std::array<std::string_view, 4> kDetailMethods = {"none", "displacement", "frames",
                                                             "transfer"};
-constexpr std::array<std::string_view, 2> kUnconstrainedPieces = {"keep", "error"};
+constexpr std::array<std::string_view, 3> kUnconstrainedPieces = {"follow", "keep", "error"};
 
 // The enumerator at the name's position in `names` (the enums count from 0 in this order).
 template <typename Enum, size_t N>

@@ -56,7 +56,7 @@ ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi
   for (int v = 0; v < n; ++v) {
     if (size[label[v]]++ == 0) first[label[v]] = v;
   }
-  set.first_held = set.vertices.size();
+  set.first_free = set.vertices.size();
   for (int c = 0; c < components; ++c) {
     if (pinned[c]) continue;
     if (pieces == UnconstrainedPieces::Error) {
@@ -65,9 +65,9 @@ ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi
                        " vertices, the first " + vertex(first[c]) +
                        ") has no handle or fixed vertex, so its position is undefined");
     }
-    ++set.held_pieces;
+    ++set.free_pieces;
   }
-  if (set.held_pieces > 0) {
+  if (set.free_pieces > 0) {
     for (int v = 0; v < n; ++v) {
       if (!pinned[label[v]]) {
         set.vertices.push_back(v);
@@ -76,6 +76,16 @@ ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi
     }
   }
   return set;
+}
+
+Eigen::VectorXd piece_area_fractions(const Eigen::VectorXd& vertex_area,
+                                     const Eigen::VectorXi& components, int count) {
+  Eigen::VectorXd piece_area = Eigen::VectorXd::Zero(count);
+  for (Eigen::Index v = 0; v < vertex_area.size(); ++v) piece_area[components[v]] += vertex_area[v];
+  Eigen::VectorXd out(vertex_area.size());
+  for (Eigen::Index v = 0; v < vertex_area.size(); ++v)
+    out[v] = vertex_area[v] / piece_area[components[v]];
+  return out;
 }
 
 Eigen::MatrixX3d constraint_targets(const ConstrainedSet& set, const Eigen::MatrixX3d& positions,

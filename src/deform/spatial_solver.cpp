@@ -3,7 +3,9 @@
 #include <Eigen/CholmodSupport>
 
 #include "membrane_stiffness.h"
+#include "specdeform/deform/selection.h"
 #include "specdeform/exceptions.h"
+#include "specdeform/mesh/mesh_info.h"
 #include "specdeform/operators/cotan_laplacian.h"
 #include "specdeform/operators/mass_matrix.h"
 
@@ -21,7 +23,9 @@ SpatialSolver::SpatialSolver(const TriangleMesh& mesh, const DeformOptions& opti
   if ((mass.array() <= 0.0).any()) {
     throw InputError("spatial solver: some vertices have zero area (only degenerate faces)");
   }
-  vertex_area_ = mass / area;
+  int pieces = 0;
+  const Eigen::VectorXi components = vertex_components(mesh, &pieces);
+  vertex_area_ = piece_area_fractions(mass, components, pieces);
   const bool arap = options.energy == DeformEnergy::Arap;
   const double ks = arap ? 1.0 : options.ks, kb = arap ? options.arap.bending : options.kb;
   const Eigen::SparseMatrix<double> Dinv_K = mass.cwiseInverse().asDiagonal() * K;

@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "deform/free_pieces.h"
 #include "deform/reduced_forms.h"
 #include "linalg/basis_product.h"
 #include "specdeform/deform/reduced_solver.h"
@@ -65,6 +66,15 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
   }
   Clock clock;
   components_ = vertex_components(mesh_, &num_components_);
+  piece_modes_.assign(num_components_, 0);
+  if (has_basis) {
+    for (Eigen::Index j = 0; j < basis_->basis.cols();
+         ++j) {  // a mode's piece: its largest entry's
+      Eigen::Index i;
+      basis_->basis.col(j).cwiseAbs().maxCoeff(&i);
+      ++piece_modes_[components_[i]];
+    }
+  }
   const Eigen::VectorXd area = lumped_mass(mesh_);
   if (has_basis) {
     const Eigen::MatrixXd& H = basis_->basis;
@@ -79,7 +89,7 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
   if (spectral) {
     reduced_ = std::make_unique<ReducedSolver>(
         basis_, arap_ ? arap_->reduced_hessian() : linear_hessian(mesh_, *basis_, options_),
-        area / area.sum(), options_);
+        piece_area_fractions(area, components_, num_components_), options_);
     if (options_.float32_basis) basis32_ = basis_->basis.cast<float>();
   } else {
     spatial_ = std::make_unique<SpatialSolver>(mesh_, options_);
@@ -97,6 +107,16 @@ SpectralDeformer& SpectralDeformer::operator=(SpectralDeformer&&) noexcept = def
 void SpectralDeformer::set_selection(const Selection& selection) {
   Clock total, clock;
   constrained_ = constrained_set(selection, components_, num_components_, options_.unconstrained);
+  constrained_piece_modes_.clear();
+  std::vector<char> driving(num_components_, 0);
+  for (size_t i = 0; i < constrained_.first_free; ++i)
+    driving[components_[constrained_.vertices[i]]] = 1;
+  for (int c = 0; c < num_components_; ++c)
+    if (driving[c]) constrained_piece_modes_.push_back(piece_modes_[c]);
+  follow_.reset();
+  if (constrained_.free_pieces > 0 && options_.unconstrained == UnconstrainedPieces::Follow) {
+    follow_ = std::make_unique<detail::FreePieces>(mesh_, components_, driving);
+  }
   if (reduced_) {
     reduced_->set_constraints(constrained_.vertices);
   } else {
@@ -156,17 +176,28 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
     deformed_base_ = base_ + state_.x;
     frame_.inverse_transform = clock.lap();
   }
-  // Held pieces stay exactly where they are (the solvers hold them only as well as soft
-  // constraints do).
+  // Free pieces stay exactly where they are (the solvers hold them only as well as soft
+  // constraints do), then follow the deformed surface around them.
   const std::vector<int>& constrained = constrained_.vertices;
-  for (size_t i = constrained_.first_held; i < constrained.size(); ++i)
+  for (size_t i = constrained_.first_free; i < constrained.size(); ++i)
     deformed_base_.row(constrained[i]) = base_.row(constrained[i]);
   detail_targets_ = options_.detail == DetailMethod::None
                         ? base_targets
                         : constraint_targets(constrained_, mesh_.V, transforms);
   Vertices result = details_->apply(deformed_base_, detail_targets_);
-  for (size_t i = constrained_.first_held; i < constrained.size(); ++i)
-    result.row(constrained[i]) = detail_targets_.row(i);
+  if (follow_) {
+    const Vertices& rest = options_.detail == DetailMethod::None ? base_ : mesh_.V;
+    const std::vector<Eigen::Affine3d> motions = follow_->motions(rest, result);
+    follow_->apply(motions, base_, deformed_base_);
+    follow_->apply(motions, rest, result);
+  }
+  for (size_t i = constrained_.first_free; i < constrained.size(); ++i) {
+    if (follow_) {
+      detail_targets_.row(i) = result.row(constrained[i]);
+    } else {
+      result.row(constrained[i]) = detail_targets_.row(i);
+    }
+  }
   frame_.detail = clock.lap();
   frame_.total = total.lap();
   return result;

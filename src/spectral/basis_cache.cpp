@@ -15,8 +15,9 @@ namespace specdeform {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'D', 'B', 'A', 'S', 'I', 'S', '\0'};
-constexpr uint32_t kVersion = 4;  // 1: no Laplacian byte (cotan); 1 and 2: no solver report;
-                                  // 1 to 3: exact bases only, no residuals per pair
+constexpr uint32_t kVersion = 5;  // 1: no Laplacian byte (cotan); 1 and 2: no solver report;
+                                  // 1 to 3: exact bases only, no residuals per pair; 1 to 4:
+                                  // no pieces and requested modes
 constexpr size_t kHeaderSize = 8 + 4 + 4 + 4 + 1 + 1 + 1 + 1 + 8;
 constexpr size_t kReportSize = 4 * 8 + 4 + 4 + 8 + 8;
 
@@ -60,7 +61,7 @@ void save_basis(const std::filesystem::path& path, const ManifoldHarmonics& basi
   }
   const bool single = precision == BasisPrecision::Float32;
   std::string out;
-  out.reserve(kHeaderSize + kReportSize + 16 * size_t(m) + (single ? 4 : 8) * size_t(n) * m);
+  out.reserve(kHeaderSize + kReportSize + 8 + 16 * size_t(m) + (single ? 4 : 8) * size_t(n) * m);
   out.append(kMagic, 8);
   put(out, kVersion);
   put(out, n);
@@ -82,6 +83,8 @@ void save_basis(const std::filesystem::path& path, const ManifoldHarmonics& basi
   put(out, static_cast<uint8_t>(basis.approximate ? 1 : 0));
   put(out, static_cast<uint32_t>(basis.coarse_functions));
   out.append(1, '\0');
+  put(out, static_cast<uint32_t>(basis.pieces));
+  put(out, static_cast<uint32_t>(basis.requested_modes > 0 ? basis.requested_modes : m));
   out.append(reinterpret_cast<const char*>(basis.eigenvalues.data()), 8 * size_t(m));
   const Eigen::VectorXd residuals = basis.residuals.size() == m
                                         ? basis.residuals
@@ -142,6 +145,18 @@ ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMe
     out.coarse_functions = static_cast<int>(get<uint32_t>(r));
   } else {
     out.max_residual = std::numeric_limits<double>::quiet_NaN();  // not recorded
+  }
+  out.pieces = 0;  // not recorded
+  out.requested_modes = static_cast<int>(m);
+  if (version >= 5) {
+    char layout[8];
+    if (!file.read(layout, 8)) throw InputError(name + ": truncated basis file");
+    const char* r = layout;
+    out.pieces = static_cast<int>(get<uint32_t>(r));
+    out.requested_modes = static_cast<int>(get<uint32_t>(r));
+    if (out.pieces < 1 || out.requested_modes < 1 || out.requested_modes > static_cast<int>(n)) {
+      throw InputError(name + ": corrupt basis header");
+    }
   }
   out.mass = mass == 0 ? MassType::Lumped : MassType::Consistent;
   out.laplacian = laplacian == 0 ? LaplacianType::Cotan : LaplacianType::IntrinsicDelaunay;

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "specdeform/exceptions.h"
+#include "specdeform/mesh/mesh_info.h"
 #include "specdeform/spectral/basis_cache.h"
 
 namespace specdeform {
@@ -12,9 +13,27 @@ namespace specdeform {
 namespace {
 
 // `h` cut to its first m pairs, or an InputError naming `file` when it cannot serve the request.
-ManifoldHarmonics serving(ManifoldHarmonics h, const ManifoldHarmonicsOptions& o,
-                          const std::filesystem::path& file) {
+ManifoldHarmonics serving(ManifoldHarmonics h, const TriangleMesh& mesh,
+                          const ManifoldHarmonicsOptions& o, const std::filesystem::path& file) {
   require_operators(file, h, o.mass, o.laplacian);
+  if (h.pieces == 0) {
+    int pieces = 1;
+    vertex_components(mesh, &pieces);
+    if (pieces > 1) {
+      throw InputError(file.string() +
+                       ": computed for the whole mesh at once by an older "
+                       "version; a mesh of several pieces is now solved piece by piece: recompute "
+                       "it");
+    }
+  }
+  if (h.pieces > 1) {
+    if (h.requested_modes != o.num_modes) {
+      throw InputError(file.string() +
+                       ": computed piece by piece for m = " + std::to_string(h.requested_modes) +
+                       ", " + std::to_string(o.num_modes) + " are asked for");
+    }
+    return h;
+  }
   if (h.basis.cols() < o.num_modes) {
     throw InputError(file.string() + ": holds " + std::to_string(h.basis.cols()) +
                      " frequencies, " + std::to_string(o.num_modes) + " are asked for");
@@ -26,6 +45,8 @@ ManifoldHarmonics serving(ManifoldHarmonics h, const ManifoldHarmonicsOptions& o
   }
   h.basis.conservativeResize(Eigen::NoChange, o.num_modes);
   h.eigenvalues.conservativeResize(o.num_modes);
+  h.residuals.conservativeResize(o.num_modes);
+  h.requested_modes = o.num_modes;
   return h;
 }
 
@@ -56,9 +77,17 @@ ObtainedBasis obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonicsOpti
   ManifoldHarmonics h;
   if (!out.file.empty() && std::filesystem::exists(out.file)) {
     if (o.progress) o.progress(0.0, "loading the basis");
-    h = serving(load_basis(out.file, mesh), o, out.file);
-    out.loaded = true;
-  } else {
+    try {
+      h = serving(load_basis(out.file, mesh), mesh, o, out.file);
+      out.loaded = true;
+    } catch (const InputError& e) {
+      if (!std::filesystem::is_directory(cache)) throw;
+      // A folder's file that cannot serve (an older format, a damaged file): computed anew.
+      std::cerr << "specdeform: warning: " << e.what() << "; computing it anew\n";
+      out.file = cache / basis_file_name(mesh, o);
+    }
+  }
+  if (!out.loaded) {
     h = compute_manifold_harmonics(mesh, o);
     if (h.status != SolveStatus::Converged) {
       if (!(h.max_residual <= kUsableResidual)) {

@@ -109,7 +109,7 @@ Spectrum solve_lanczos(const Sparse& K, const Sparse& M, const ManifoldHarmonics
   return out;
 }
 
-Mat stiffness_null_space(const Sparse& K, const Sparse& M) {
+int stiffness_components(const Sparse& K, std::vector<int>& label) {
   const int n = static_cast<int>(K.rows());
   std::vector<int> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
@@ -120,13 +120,20 @@ Mat stiffness_null_space(const Sparse& K, const Sparse& M) {
   for (int col = 0; col < K.outerSize(); ++col)
     for (Sparse::InnerIterator it(K, col); it; ++it)
       parent[find(static_cast<int>(it.row()))] = find(col);
-  std::vector<int> label(n, -1);
+  label.assign(n, -1);
   int count = 0;
   for (int i = 0; i < n; ++i) {
     int& l = label[find(i)];
     if (l < 0) l = count++;
     label[i] = l;
   }
+  return count;
+}
+
+Mat stiffness_null_space(const Sparse& K, const Sparse& M) {
+  const int n = static_cast<int>(K.rows());
+  std::vector<int> label;
+  const int count = stiffness_components(K, label);
   Mat Z = Mat::Zero(n, count);
   for (int i = 0; i < n; ++i) Z(i, label[i]) = 1.0;
   const Vec norms = (Z.transpose() * (M * Z)).diagonal().cwiseSqrt();

@@ -9,6 +9,8 @@
 //    a coarse partition-of-unity space (spectral/coarse_space.h), solved exactly there.
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 #include <Eigen/Sparse>
 
@@ -39,6 +41,10 @@ Spectrum solve_multilevel(const Eigen::SparseMatrix<double>& K,
                           const Eigen::SparseMatrix<double>& M,
                           const Eigen::SparseMatrix<double>& lengths,
                           const ManifoldHarmonicsOptions& options);
+
+// The connected components of K's graph (its stored entries): a label in [0, count) per
+// vertex, numbered by first vertex; returns count.
+int stiffness_components(const Eigen::SparseMatrix<double>& K, std::vector<int>& label);
 
 // K's null space, known exactly: the constants on each connected component of K's graph,
 // M-normalised; n x (number of components).

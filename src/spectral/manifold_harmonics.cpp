@@ -12,6 +12,7 @@
 #include "spectral/coarse_space.h"
 #include "spectral/eigen_residual.h"
 #include "spectral/eigensolvers.h"
+#include "spectral/piecewise.h"
 
 namespace specdeform {
 
@@ -54,6 +55,8 @@ void ManifoldHarmonicsPolicy::validate() const {
   require(multilevel_support > 1.0, "multilevel_support must be > 1");
   require(multilevel_reduction >= 1, "multilevel_reduction must be >= 1");
   require(multilevel_from >= 0, "multilevel_from must be >= 0");
+  require(piece_min_modes >= 1 && piece_modes_limit >= 1,
+          "piece_min_modes and piece_modes_limit must be >= 1");
 }
 
 void ManifoldHarmonicsOptions::validate() const {
@@ -86,7 +89,33 @@ double orthonormality_error(const Sparse& M, const Mat& H) {
 
 namespace {
 
-// Both overloads: `lengths` gives the multilevel solver's distances (coarse_space.h).
+// One connected piece (or the whole mesh), M of unit area: the solver the options and the
+// size ask for. `lengths`: the multilevel solver's distances (coarse_space.h).
+detail::Spectrum solve_connected(const Sparse& K, const Sparse& M_unit, const Sparse* lengths,
+                                 const ManifoldHarmonicsOptions& o) {
+  const int n = static_cast<int>(K.rows());
+  const int m = o.num_modes;
+  const ManifoldHarmonicsPolicy& p = o.policy;
+  const int first_band = std::min(m, p.single_band_limit) + 2;
+  const bool dense = n <= p.dense_limit || 3 * m > 2 * n || 4 * first_band > n;
+  const int samples = std::max(p.multilevel_min_samples, p.multilevel_samples_per_mode * m);
+  if (o.solver == EigenSolver::Multilevel &&
+      static_cast<double>(n) >= double(p.multilevel_reduction) * samples) {
+    return detail::solve_multilevel(K, M_unit, *lengths, o);
+  }
+  if (dense) {
+    if (n > 6000) {
+      throw InputError("manifold harmonics: m = " + std::to_string(m) + " is too close to n = " +
+                       std::to_string(n) + " for an iterative solver; use m <= 2n/3");
+    }
+    detail::report(o, 0.0, "dense eigensolver");
+    return detail::solve_dense(K, M_unit, m);
+  }
+  if (o.solver == EigenSolver::Lanczos) return detail::solve_lanczos(K, M_unit, o);
+  return detail::solve_block_krylov(K, M_unit, o);
+}
+
+// Both overloads: `lengths` gives the multilevel solver's distances, or null.
 ManifoldHarmonics harmonics(const Sparse& K, const Sparse& M, const Sparse* lengths,
                             const ManifoldHarmonicsOptions& o) {
   o.validate();
@@ -107,41 +136,40 @@ ManifoldHarmonics harmonics(const Sparse& K, const Sparse& M, const Sparse* leng
   }
   const double area = row_sums.sum();
   const Sparse M_unit = M / area;
-
-  detail::Spectrum s;
   const ManifoldHarmonicsPolicy& p = o.policy;
-  const int first_band = std::min(m, p.single_band_limit) + 2;
-  const bool dense = n <= p.dense_limit || 3 * m > 2 * n || 4 * first_band > n;
-  const int samples = std::max(p.multilevel_min_samples, p.multilevel_samples_per_mode * m);
-  const bool multilevel = o.solver == EigenSolver::Multilevel &&
-                          static_cast<double>(n) >= double(p.multilevel_reduction) * samples;
-  if (multilevel) {
-    s = detail::solve_multilevel(K, M_unit,
-                                 lengths ? *lengths : detail::estimated_edge_lengths(K, M_unit), o);
-  } else if (dense) {
-    if (n > 6000) {
-      throw InputError("manifold harmonics: m = " + std::to_string(m) + " is too close to n = " +
-                       std::to_string(n) + " for an iterative solver; use m <= 2n/3");
-    }
-    detail::report(o, 0.0, "dense eigensolver");
-    s = detail::solve_dense(K, M_unit, m);
-  } else if (o.solver == EigenSolver::Lanczos) {
-    s = detail::solve_lanczos(K, M_unit, o);
-  } else {
-    s = detail::solve_block_krylov(K, M_unit, o);
-  }
+
+  std::vector<int> label;
+  const int pieces = detail::stiffness_components(K, label);
+  bool multilevel = false;
+  const detail::ConnectedSolver connected = [&](const Sparse& K_piece, const Sparse& M_piece,
+                                                const Sparse* lengths_piece,
+                                                const ManifoldHarmonicsOptions& op) {
+    detail::Spectrum piece = solve_connected(K_piece, M_piece, lengths_piece, op);
+    multilevel = multilevel || piece.coarse_functions > 0;
+    return piece;
+  };
+  const Sparse estimated = o.solver == EigenSolver::Multilevel && !lengths
+                               ? detail::estimated_edge_lengths(K, M_unit)
+                               : Sparse();
+  if (!lengths && o.solver == EigenSolver::Multilevel) lengths = &estimated;
+  detail::Spectrum s = pieces > 1
+                           ? detail::solve_by_piece(K, M_unit, lengths, label, pieces, o, connected)
+                           : connected(K, M_unit, lengths, o);
+  const int columns = static_cast<int>(s.lambda.size());
   ManifoldHarmonics out;
   out.status = s.status;
   out.cluster_truncated = s.cluster_truncated;
   out.approximate = multilevel;
   out.coarse_functions = s.coarse_functions;
+  out.pieces = pieces;
+  out.requested_modes = m;
   out.bands = s.bands;
   out.restarts = s.restarts;
   out.solves = s.solves;
   out.eigenvalues = s.lambda / area;
   out.basis = std::move(s.H);
   out.basis /= std::sqrt(area);
-  for (int j = 0; j < m; ++j) {  // sign convention: largest-magnitude entry positive
+  for (int j = 0; j < columns; ++j) {  // sign convention: largest-magnitude entry positive
     Eigen::Index i;
     out.basis.col(j).cwiseAbs().maxCoeff(&i);
     if (out.basis(i, j) < 0) out.basis.col(j) *= -1.0;

@@ -137,7 +137,8 @@ TEST_F(SceneFiles, FieldsOfTheWrongTypeNameThemselves) {
       {R"({"handles": [{"vertices": [0]}], "settings": {"ks": 0, "kb": 0}})",
        "settings: deformation options: ks and kb"},
       {R"({"handles": [{"vertices": [0]}], "settings": {"unconstrained": "drop"}})",
-       "settings unconstrained: unknown unconstrained-pieces policy 'drop' (keep or error)"},
+       "settings unconstrained: unknown unconstrained-pieces policy 'drop' (follow, keep or "
+       "error)"},
       {R"({"handles": [{"vertices": [0]}], "settings": {"kb": -1}})", "ks and kb"},
       {R"({"handles": [{"vertices": [0]}], "setings": {}})", "unknown key 'setings'"},
       {R"({"mesh": 3, "handles": [{"vertices": [0]}]})", "mesh: expected a string, got a number"},

@@ -65,7 +65,9 @@ Outcome run(const TriangleMesh& mesh) {
   on_model(selection.handles[0]);
   on_model(selection.fixed);
   Outcome out;
-  SpectralDeformer deformer(mesh, basis);
+  DeformOptions keep;  // the debris held, so that its vertices must come back unchanged
+  keep.unconstrained = UnconstrainedPieces::Keep;
+  SpectralDeformer deformer(mesh, basis, keep);
   deformer.set_selection(selection);
   out.identity = point_distances(deformer.solve({Eigen::Affine3d::Identity()}), mesh.V).max /
                  bounding_box_diagonal(mesh.V);

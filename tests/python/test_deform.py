@@ -220,15 +220,23 @@ def test_report_timings_and_options(bar):
     assert deformer.deformed_base.shape == X.shape and deformer.deformed_base.flags.writeable
 
 
-def test_pieces_without_handles_are_held_or_refused():
+def test_pieces_without_handles_follow_are_held_or_refused():
     V1, F1 = specdeform.icosphere(2)
     V = np.vstack([V1, V1 + [3, 0, 0]])
     F = np.vstack([F1, F1 + len(V1)])
     handle, fixed = np.arange(5), np.arange(100, 110)
-    deformer = specdeform.SpectralDeformer(V, F, 18, detail="displacement")
+    follow = specdeform.SpectralDeformer(V, F, 18, detail="displacement")
+    follow.set_selection([handle], fixed)
+    X = follow.solve(turn(0, V[0], (0, 0.2, 0)))
+    assert follow.report["free_pieces"] == 1
+    assert follow.report["constrained_piece_modes"] == [16]  # 9 by area, 16 at least
+    free = X[len(V1):]
+    assert np.abs(free - V[len(V1):]).max() > 1e-3  # moved along, rigidly
+    np.testing.assert_allclose(np.linalg.norm(free - free[0], axis=1),
+                               np.linalg.norm(V1 - V1[0], axis=1), atol=1e-12)
+    deformer = specdeform.SpectralDeformer(V, F, 18, detail="displacement", unconstrained="keep")
     deformer.set_selection([handle], fixed)
     X = deformer.solve(turn(0, V[0], (0, 0.2, 0)))
-    assert deformer.report["held_pieces"] == 1
     np.testing.assert_array_equal(X[len(V1):], V[len(V1):])
     strict = specdeform.SpectralDeformer(V, F, 18, unconstrained="error")
     with pytest.raises(specdeform.InputError, match="162"):

@@ -10,6 +10,8 @@
 
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/generate.h"
+#include "specdeform/spectral/basis_store.h"
+#include "support/corpus.h"
 
 namespace specdeform {
 namespace {
@@ -72,14 +74,16 @@ TEST_F(BasisCache, RecordsTheLaplacian) {
 }
 
 // Rewrites a file of this version (m pairs) as an older one: that version number, without the
-// residuals per pair (8 m bytes after the eigenvalues) that version 4 added and, before
-// version 3, without the solver report (56 bytes after the 32-byte header).
+// layout (8 bytes after the report) that version 5 added, the residuals per pair (8 m bytes
+// after the eigenvalues) that version 4 added and, before version 3, without the solver report
+// (56 bytes after the 32-byte header).
 void downgrade(const std::filesystem::path& path, uint32_t version, size_t m) {
   std::string bytes;
   {
     std::ifstream file(path, std::ios::binary);
     bytes.assign(std::istreambuf_iterator<char>(file), {});
   }
+  bytes.erase(32 + 56, 8);
   bytes.erase(32 + 56 + 8 * m, 8 * m);
   if (version < 3) bytes.erase(32, 56);
   std::memcpy(bytes.data() + 8, &version, sizeof version);
@@ -140,6 +144,31 @@ TEST_F(BasisCache, RefusesAnotherMeshOrABrokenFile) {
   std::ofstream(dir_ / "junk.sdbasis") << "not a basis at all, but long enough for a header";
   EXPECT_THROW(load_basis(dir_ / "junk.sdbasis", mesh_), InputError);
   EXPECT_THROW(load_basis(dir_ / "missing.sdbasis", mesh_), InputError);
+}
+
+// A basis of several pieces records them and the m asked for (it has more columns); it serves
+// that m only, and a folder's file of an older version for such a mesh is computed anew.
+TEST_F(BasisCache, APieceByPieceBasisServesItsOwnM) {
+  TriangleMesh shifted = make_icosphere(2);
+  shifted.V.col(0).array() += 3.0;
+  const TriangleMesh two = test::concatenate(make_icosphere(2), shifted);
+  ManifoldHarmonicsOptions o;
+  o.num_modes = 20;
+  const ObtainedBasis first = obtain_basis(two, o, dir_);
+  EXPECT_FALSE(first.loaded);
+  EXPECT_EQ(first.harmonics->pieces, 2);
+  EXPECT_EQ(first.harmonics->basis.cols(), 32);  // 10 each by area, 16 each by the floor
+  const ObtainedBasis again = obtain_basis(two, o, dir_);
+  EXPECT_TRUE(again.loaded);
+  EXPECT_EQ(again.harmonics->basis, first.harmonics->basis);
+  EXPECT_EQ(again.harmonics->requested_modes, 20);
+  ManifoldHarmonicsOptions fewer = o;
+  fewer.num_modes = 10;
+  EXPECT_THROW(obtain_basis(two, fewer, again.file), InputError);
+  downgrade(again.file, 3, 32);
+  const ObtainedBasis anew = obtain_basis(two, o, dir_);
+  EXPECT_FALSE(anew.loaded);
+  EXPECT_EQ(anew.harmonics->basis.cols(), 32);
 }
 
 }  // namespace

@@ -271,7 +271,8 @@ export class Panel {
     $('counts').textContent = r && editable
       ? `handles: ${c.handles.toLocaleString()} vertices in ${c.groups} group${c.groups === 1 ? '' : 's'} · ` +
         `fixed: ${c.fixed.toLocaleString()} · pinned: ${c.pinned.toLocaleString()}` +
-        (s.server?.held_pieces ? ` · ${s.server.held_pieces} piece(s) without handles held in place` : '')
+        (s.server?.free_pieces ? ` · ${s.server.free_pieces} piece(s) without handles ${s.server.unconstrained === 'keep' ? 'held in place' : 'follow the surface'}` : '') +
+        ((s.server?.constrained_piece_modes?.length ?? 0) > 1 ? ` · modes per constrained piece: ${s.server!.constrained_piece_modes.join(', ')}` : '')
       : '';
     this.renderNotes();
 

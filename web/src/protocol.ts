@@ -73,7 +73,9 @@ export interface StateMessage {
   redo: boolean;
   selection_seconds: number;
   pin_error: number;
-  held_pieces: number;
+  free_pieces: number; // pieces without a constrained vertex
+  unconstrained: 'follow' | 'keep' | 'error'; // what they do
+  constrained_piece_modes: number[]; // the basis's modes on each piece with a handle or fixed vertex
   pose: number;
 }
 

@@ -10,8 +10,8 @@
 //    vectors (stretching) and mean-curvature normals (bending) turned by one rotation per
 //    cluster of vertices, minimised by quasi-Newton local/global iterations (arap_solver.h).
 //    It keeps the shape under large rotations; the default.
-// Soft constraints add  w sum_{i in C} a_i |s'_i - t_i|^2,  a_i the vertex's lumped area on the
-// unit-area scale (so w does not depend on resolution).
+// Soft constraints add  w sum_{i in C} a_i |s'_i - t_i|^2,  a_i the vertex's lumped area over
+// its connected piece's area (so w does not depend on resolution, nor on the other pieces).
 #pragma once
 
 #include <string_view>
@@ -42,8 +42,9 @@ enum class DetailMethod {
 
 // A connected component of the mesh with no handle or fixed vertex.
 enum class UnconstrainedPieces {
-  Keep,   // stays where it is (its vertices are held in place); counted in the report
-  Error,  // is an InputError naming the piece
+  Follow,  // moves rigidly with the deformed surface around it (deform/free_pieces.h)
+  Keep,    // stays where it is (its vertices are held in place)
+  Error,   // is an InputError naming the piece
 };
 
 // DeformEnergy::Arap: its bending weight, rotation clusters and iterations.
@@ -61,14 +62,14 @@ struct ArapOptions {
 
 struct DeformOptions {
   DeformEnergy energy = DeformEnergy::Arap;  // measured: docs/results.md, "Rotations"
-  double ks = 0.0;  // Linear: stretching weight
-  double kb = 1.0;  // Linear: bending weight
+  double ks = 0.0;                           // Linear: stretching weight
+  double kb = 1.0;                           // Linear: bending weight
   ArapOptions arap;
   ConstraintMode constraints = ConstraintMode::Soft;
   double constraint_weight = 1e5;  // w of the soft constraints
   DeformSolver solver = DeformSolver::Spectral;
   DetailMethod detail = DetailMethod::Transfer;
-  UnconstrainedPieces unconstrained = UnconstrainedPieces::Keep;
+  UnconstrainedPieces unconstrained = UnconstrainedPieces::Follow;
   bool float32_basis = false;  // keep the basis in single precision (faster frames)
 
   // Throws InputError, naming the field, for a value out of range.

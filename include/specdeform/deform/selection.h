@@ -21,14 +21,15 @@ struct Selection {
 };
 
 // The constrained vertices of a selection in one list, with the group of each (-1 = fixed).
-// The vertices of held pieces (connected components without a handle or fixed vertex, under
-// UnconstrainedPieces::Keep) end the list, as fixed vertices, from index `first_held` on.
+// The vertices of free pieces (connected components without a handle or fixed vertex, under
+// UnconstrainedPieces::Follow or Keep) end the list, as fixed vertices, from index `first_free`
+// on: the solvers hold them, and the deformer then keeps them or moves them along.
 struct ConstrainedSet {
   std::vector<int> vertices;
   std::vector<int> group;
   int num_groups = 0;
-  int held_pieces = 0;
-  size_t first_held = 0;
+  int free_pieces = 0;
+  size_t first_free = 0;
 };
 
 // Throws InputError for an empty selection, an index out of [0, n), a vertex in two groups, or,
@@ -43,6 +44,12 @@ ConstrainedSet constrained_set(const Selection& selection, const TriangleMesh& m
 ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi& components,
                                int count, UnconstrainedPieces pieces,
                                const std::vector<int>& file_index = {});
+
+// The soft constraints' vertex weights a_i: each vertex's lumped area over its connected
+// piece's area, so that a piece weighs its constraints as it would alone (on the whole mesh's
+// area, a sphere of a 100-sphere assembly would hold its handle 100 times more loosely).
+Eigen::VectorXd piece_area_fractions(const Eigen::VectorXd& vertex_area,
+                                     const Eigen::VectorXi& components, int count);
 
 // Target position of every constrained vertex (|C| x 3): the group's transform applied to
 // `positions` (fixed vertices keep theirs). Throws InputError for a wrong number of transforms,

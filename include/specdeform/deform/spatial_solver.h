@@ -63,7 +63,7 @@ class SpatialSolver {
   struct Factor;
   DeformOptions options_;
   Eigen::SparseMatrix<double> A_;
-  Eigen::VectorXd vertex_area_;  // unit-area scale
+  Eigen::VectorXd vertex_area_;  // the soft constraints' a_i (piece_area_fractions)
   std::vector<int> constrained_;
   std::vector<int> free_;                 // hard: the free vertices
   Eigen::SparseMatrix<double> coupling_;  // hard: A_FC

@@ -13,8 +13,9 @@
 // fixed vertices stay; the detailed result's handle vertices should reach T x_i and its fixed
 // vertices x_i. Transfer anchors them there exactly; the other methods meet them only as far as
 // the base does (constraint_error() measures it). A connected component without a handle or
-// fixed vertex stays where it is (UnconstrainedPieces::Keep: its vertices are held like fixed
-// ones and returned unchanged) or is an InputError.
+// fixed vertex (a free piece) moves rigidly with the deformed surface around it
+// (UnconstrainedPieces::Follow, deform/free_pieces.h), stays where it is (Keep) or is an
+// InputError.
 //
 //   SpectralDeformer deformer(mesh, compute_manifold_harmonics(mesh, {.num_modes = 100}));
 //   deformer.set_selection({.handles = {hand}, .fixed = feet});
@@ -37,6 +38,9 @@ namespace specdeform {
 
 class ReducedSolver;
 class SpatialSolver;
+namespace detail {
+class FreePieces;
+}
 
 // Seconds spent in each stage.
 struct SetupTimings {
@@ -93,8 +97,12 @@ class SpectralDeformer {
   const ArapReport& arap_report() const { return arap_report_; }
   // ARAP: the number of rotation clusters (0 for the linear energy).
   int rotation_clusters() const { return arap_ ? arap_->clusters() : 0; }
-  // Connected components held in place by the last selection (they had no constrained vertex).
-  int held_pieces() const { return constrained_.held_pieces; }
+  // Connected components without a constrained vertex in the last selection (they follow the
+  // surface or are held in place, as options().unconstrained says).
+  int free_pieces() const { return constrained_.free_pieces; }
+  // The basis's modes on each piece that has a constrained vertex in the last selection, in
+  // the order of the pieces' first vertices (one entry, all the modes, for a mesh of one piece).
+  const std::vector<int>& constrained_piece_modes() const { return constrained_piece_modes_; }
 
  private:
   TriangleMesh mesh_;
@@ -106,8 +114,11 @@ class SpectralDeformer {
   std::unique_ptr<SpatialSolver> spatial_;
   std::unique_ptr<ArapSolver> arap_;
   std::unique_ptr<DetailReconstruction> details_;
-  Eigen::VectorXi components_;  // connected component of each vertex
+  std::unique_ptr<detail::FreePieces> follow_;  // Follow: the free pieces of the selection
+  Eigen::VectorXi components_;                  // connected component of each vertex
   int num_components_ = 0;
+  std::vector<int> piece_modes_;  // the basis's modes on each connected component
+  std::vector<int> constrained_piece_modes_;
   ConstrainedSet constrained_;
   ArapState state_;                  // c (spectral) or d (spatial) of the last solve, and
                                      // ARAP's rotations

@@ -3,13 +3,15 @@
 // Binary, little-endian, versioned:
 //   "SDBASIS\0" (8 bytes) | version u32 | n u32 | m u32 | mass u8 (0 lumped, 1 consistent) |
 //   scalar u8 (8 = float64, 4 = float32) | laplacian u8 (0 cotan, 1 intrinsic-delaunay) |
-//   reserved u8 | mesh hash u64 | solver report | eigenvalues (m x f64) | residuals (m x f64,
-//   version 4 on) | basis (n x m, column-major, float64 or float32)
+//   reserved u8 | mesh hash u64 | solver report | layout | eigenvalues (m x f64) | residuals (m x
+//   f64, version 4 on) | basis (n x m, column-major, float64 or float32)
 // with the solver report (version 3 on) max_residual, rounding_floor, threshold,
 // max_orthogonality_error (f64 each) | bands u32 | restarts u32 | solves u64 | converged u8 |
 // cluster_truncated u8 | approximate u8 | coarse_functions u32 | 1 reserved byte (version 3:
 // 6 reserved bytes, zero: an exact basis), so that a basis read back reports how it was computed
-// (a multilevel basis says it is approximate, and its residual per pair).
+// (a multilevel basis says it is approximate, and its residual per pair); then (version 5 on)
+// the layout: pieces u32 | requested_modes u32 (a basis of several pieces has more columns
+// than asked).
 // Version 2 added the Laplacian in a byte that version 1 reserved (always 0): version 1 files
 // are read as cotan bases; files of versions 1 and 2 read back with max_residual NaN (unknown). The
 // mesh hash covers the vertex positions and the faces, so loading refuses, with a clear message, a

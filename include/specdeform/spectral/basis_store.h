@@ -6,9 +6,11 @@
 // "0123456789abcdef-m100-lumped.sdbasis" or "...-m100-lumped-multilevel.sdbasis" (the names the
 // editor and the Python module have always used for the defaults). A file serves a request when
 // it was computed for this mesh and these operators and holds at least m pairs (the first m are
-// taken). An exact basis serves any request (a folder's exact file is taken for a multilevel
-// request too); an approximate (multilevel) one only a multilevel request: a folder keeps the two
-// apart by name, a named file holding the wrong kind is an InputError rather than overwritten.
+// taken; a basis computed piece by piece serves only the m it was computed for). A folder's file
+// that cannot serve (an older format, say) is computed anew and replaced. An exact basis serves any
+// request (a folder's exact file is taken for a multilevel request too); an approximate
+// (multilevel) one only a multilevel request: a folder keeps the two apart by name, a named file
+// holding the wrong kind is an InputError rather than overwritten.
 #pragma once
 
 #include <filesystem>
@@ -29,7 +31,8 @@ inline constexpr double kUsableResidual = 1e-6;
 std::string basis_file_name(const TriangleMesh& mesh, const ManifoldHarmonicsOptions& options);
 
 struct ObtainedBasis {
-  std::shared_ptr<const ManifoldHarmonics> harmonics;  // exactly options.num_modes pairs
+  std::shared_ptr<const ManifoldHarmonics> harmonics;  // options.num_modes pairs (more on
+                                                       // several pieces)
   std::filesystem::path file;                          // read or written; empty: none
   bool loaded = false;                                 // read from the cache
   double seconds = 0.0;                                // to load or to compute

@@ -28,10 +28,17 @@
 //    deformation energy (computed from H itself) stay exact in its span; but H is not made of
 //    eigenvectors of K and M (`approximate`; the residuals say how far). Linear in n: no fine
 //    factorisation. Meshes of fewer than multilevel_reduction * N vertices get the exact solver.
+// Several connected pieces: K and M are block diagonal, and the harmonics are the union of each
+// piece's own, computed piece by piece (spectral/piecewise.h). m is split by area with a floor:
+// a piece gets m a_i / A modes, at least min(policy.piece_min_modes, its vertices), so that
+// every piece can deform (the whole mesh's first m pairs would begin with one zero eigenvalue per
+// piece: a 100-piece assembly at m = 100 would get constants only). The basis then has more than
+// m columns (m_i summed; `pieces` and `requested_modes` record the split), each supported on
+// one piece, in ascending order of eigenvalue.
 // Each eigenvector's sign is fixed so that its entry of largest magnitude is positive; random
-// start vectors are seeded, so the output is reproducible. Several connected components give
-// one zero eigenvalue each. If m ends inside a cluster of (nearly) equal eigenvalues, the
-// truncated basis depends on an arbitrary rotation of that cluster: `cluster_truncated` says so.
+// start vectors are seeded, so the output is reproducible. If m ends inside a cluster of
+// (nearly) equal eigenvalues, the truncated basis depends on an arbitrary rotation of that
+// cluster: `cluster_truncated` says so.
 #pragma once
 
 #include <cstdint>
@@ -91,12 +98,19 @@ struct ManifoldHarmonicsPolicy {
   // The front ends' choice without a flag (default_eigensolver): multilevel from this many
   // vertices (docs/results.md, "Large meshes").
   int multilevel_from = 200000;
+  // Several pieces (spectral/piecewise.h): each gets at least this many modes (or all its
+  // vertices), with at most piece_modes_limit * m in all (beyond, the pieces of least area keep
+  // their constant only). A sphere of a 100-sphere assembly, pulled by 0.8 radii and turned by
+  // 0.6 rad: its base missed the handle by 0.41% of the diagonal with 10 modes, 0.11% with 16
+  // (the spherical harmonics of degree <= 3), 0.09% with 20 (tests/spectral/piecewise_test.cpp).
+  int piece_min_modes = 16;
+  int piece_modes_limit = 16;
 
   void validate() const;  // throws InputError
 };
 
 struct ManifoldHarmonicsOptions {
-  int num_modes = 100;  // m, 1 <= m < n
+  int num_modes = 100;  // m, 1 <= m < n (split among several pieces, see above)
   MassType mass = MassType::Lumped;
   LaplacianType laplacian = LaplacianType::Cotan;  // the mesh overload's K and M
   EigenSolver solver = EigenSolver::BlockKrylov;
@@ -115,7 +129,7 @@ struct ManifoldHarmonicsOptions {
 enum class SolveStatus { Converged, NotConverged };
 
 struct ManifoldHarmonics {
-  Eigen::VectorXd eigenvalues;  // m, ascending, mesh units
+  Eigen::VectorXd eigenvalues;  // m (more on several pieces), ascending, mesh units
   Eigen::MatrixXd basis;        // n x m, H^T M H = I
   MassType mass = MassType::Lumped;
   LaplacianType laplacian = LaplacianType::Cotan;  // H is orthonormal in this Laplacian's M
@@ -133,6 +147,10 @@ struct ManifoldHarmonics {
   // eigenvectors; `status` is the coarse solve's and the residuals measure the approximation.
   bool approximate = false;
   int coarse_functions = 0;
+  // Connected pieces, solved one by one when more than one (0: not recorded, a basis file of
+  // version 4 or older); the m asked for (the basis has more columns when pieces > 1).
+  int pieces = 1;
+  int requested_modes = 0;
   int bands = 0;  // shifts used (= factorizations)
   int restarts = 0;
   long long solves = 0;  // right-hand sides solved with the factorization

@@ -1,0 +1,144 @@
+#include "deform/free_pieces.h"
+
+#include <algorithm>
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+#include <Eigen/SVD>
+
+#include "specdeform/exceptions.h"
+
+namespace specdeform::detail {
+
+namespace {
+
+using Kernel = CGAL::Simple_cartesian<double>;
+using Point = Kernel::Point_3;
+using Triangle = Kernel::Triangle_3;
+using Primitive = CGAL::AABB_triangle_primitive<Kernel, std::vector<Triangle>::const_iterator>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+
+Point point(const Vertices& V, Eigen::Index i) {
+  return {V(i, 0), V(i, 1), V(i, 2)};
+}
+
+// Barycentric coordinates of p (on or near the triangle's plane) in the triangle (a, b, c).
+Eigen::Vector3d barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                            const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  Eigen::Matrix<double, 3, 2> E;
+  E << b - a, c - a;
+  const Eigen::Vector2d uv = (E.transpose() * E).ldlt().solve(E.transpose() * (p - a));
+  return {1.0 - uv.sum(), uv[0], uv[1]};
+}
+
+// The rotation nearest to A (Frobenius norm).
+Eigen::Matrix3d nearest_rotation(const Eigen::Matrix3d& A) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d U = svd.matrixU();
+  if ((U * svd.matrixV().transpose()).determinant() < 0.0) U.col(2) *= -1.0;
+  return U * svd.matrixV().transpose();
+}
+
+// The triangle's edge frame: its two edges and its normal, scaled like an edge.
+Eigen::Matrix3d edge_frame(const Vertices& V, const Eigen::Vector3i& f) {
+  const Eigen::Vector3d a = V.row(f[0]);
+  const Eigen::Vector3d e1 = V.row(f[1]).transpose() - a, e2 = V.row(f[2]).transpose() - a;
+  const Eigen::Vector3d n = e1.cross(e2);
+  Eigen::Matrix3d frame;
+  frame << e1, e2, n / std::sqrt(std::max(n.norm(), 1e-300));
+  return frame;
+}
+
+}  // namespace
+
+FreePieces::FreePieces(const TriangleMesh& mesh, const Eigen::VectorXi& components,
+                       const std::vector<char>& driving, const FreePiecePolicy& policy)
+    : faces_(mesh.F) {
+  std::vector<int> piece_of(driving.size(), -1);
+  for (size_t c = 0; c < driving.size(); ++c) {
+    if (!driving[c]) {
+      piece_of[c] = static_cast<int>(pieces_.size());
+      pieces_.emplace_back();
+    }
+  }
+  if (pieces_.empty()) return;
+  for (int v = 0; v < mesh.num_vertices(); ++v) {
+    if (piece_of[components[v]] >= 0) pieces_[piece_of[components[v]]].vertices.push_back(v);
+  }
+  std::vector<Triangle> triangles;
+  std::vector<int> face_of;
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    if (!driving[components[mesh.F(f, 0)]]) continue;
+    const Triangle t(point(mesh.V, mesh.F(f, 0)), point(mesh.V, mesh.F(f, 1)),
+                     point(mesh.V, mesh.F(f, 2)));
+    if (t.is_degenerate()) continue;
+    triangles.push_back(t);
+    face_of.push_back(f);
+  }
+  if (triangles.empty()) {
+    throw InputError("free pieces: the constrained pieces have no triangle to follow");
+  }
+  Tree tree(triangles.begin(), triangles.end());
+  tree.accelerate_distance_queries();
+  for (Piece& piece : pieces_) {
+    Eigen::AlignedBox3d box;
+    for (const int v : piece.vertices) box.extend(Eigen::Vector3d(mesh.V.row(v)));
+    const double softening = policy.softening * std::max(box.diagonal().norm(), 1e-300);
+    const size_t count = piece.vertices.size();
+    const size_t samples = std::min<size_t>(count, policy.samples);
+    for (size_t s = 0; s < samples; ++s) {
+      const int v = piece.vertices[s * count / samples];
+      const auto [q, it] = tree.closest_point_and_primitive(point(mesh.V, v));
+      const int f = face_of[it - triangles.cbegin()];
+      const Eigen::Vector3d closest(q.x(), q.y(), q.z());
+      const double d = (closest - mesh.V.row(v).transpose()).norm() + softening;
+      piece.samples.push_back({f,
+                               barycentric(closest, mesh.V.row(mesh.F(f, 0)),
+                                           mesh.V.row(mesh.F(f, 1)), mesh.V.row(mesh.F(f, 2))),
+                               1.0 / (d * d)});
+    }
+  }
+}
+
+std::vector<Eigen::Affine3d> FreePieces::motions(const Vertices& rest,
+                                                 const Vertices& deformed) const {
+  std::vector<Eigen::Affine3d> out;
+  out.reserve(pieces_.size());
+  for (const Piece& piece : pieces_) {
+    Eigen::Matrix3d rotations = Eigen::Matrix3d::Zero();
+    for (const Sample& s : piece.samples) {
+      const Eigen::Vector3i f = faces_.row(s.face);
+      const Eigen::Matrix3d gradient = edge_frame(deformed, f) * edge_frame(rest, f).inverse();
+      rotations += s.weight * nearest_rotation(gradient);
+    }
+    const Eigen::Matrix3d R = nearest_rotation(rotations);
+    Eigen::Vector3d t = Eigen::Vector3d::Zero();
+    double weights = 0.0;
+    for (const Sample& s : piece.samples) {
+      Eigen::Vector3d q = Eigen::Vector3d::Zero(), q_deformed = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 3; ++k) {
+        q += s.barycentric[k] * rest.row(faces_(s.face, k)).transpose();
+        q_deformed += s.barycentric[k] * deformed.row(faces_(s.face, k)).transpose();
+      }
+      t += s.weight * (q_deformed - R * q);
+      weights += s.weight;
+    }
+    Eigen::Affine3d motion = Eigen::Affine3d::Identity();
+    motion.linear() = R;
+    motion.translation() = t / weights;
+    out.push_back(motion);
+  }
+  return out;
+}
+
+void FreePieces::apply(const std::vector<Eigen::Affine3d>& motions, const Vertices& positions,
+                       Vertices& out) const {
+  for (size_t p = 0; p < pieces_.size(); ++p) {
+    for (const int v : pieces_[p].vertices)
+      out.row(v) = (motions[p] * positions.row(v).transpose()).transpose();
+  }
+}
+
+}  // namespace specdeform::detail
