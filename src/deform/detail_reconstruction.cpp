@@ -6,6 +6,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <Eigen/SVD>
 
 #include "anchored_poisson.h"
 #include "linalg/parallel.h"
@@ -19,18 +20,26 @@ namespace {
 
 using Sparse = Eigen::SparseMatrix<double>;
 
-// Orthonormal frame (tangent, bitangent, normal) as the columns of a 3 x 3 matrix; the zero
-// matrix where the normal or the tangent is undefined.
-Eigen::Matrix3d vertex_frame(const Eigen::Vector3d& normal, const Eigen::Vector3d& edge) {
-  const Eigen::Vector3d t = edge - edge.dot(normal) * normal;
-  if (normal.squaredNorm() == 0.0 || t.norm() <= 1e-12 * edge.norm()) {
-    return Eigen::Matrix3d::Zero();
+// The rotation nearest to the map of the one-ring of vertex i (edge vectors to its neighbours and
+// its normal) from `rest` to `deformed`: R = argmin sum_j |e'_ij - R e_ij|^2 + l^2 |n'_i - R
+// n_i|^2, l the mean rest edge length (the normal weighs like an edge), by the polar decomposition.
+Eigen::Matrix3d ring_rotation(const Vertices& rest, const Vertices& deformed,
+                              const Eigen::Matrix<double, Eigen::Dynamic, 3>& rest_normals,
+                              const Eigen::Matrix<double, Eigen::Dynamic, 3>& normals,
+                              const int* ring, int size, int i) {
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  double length = 0.0;
+  for (int k = 0; k < size; ++k) {
+    const Eigen::Vector3d e = rest.row(ring[k]) - rest.row(i);
+    A += (deformed.row(ring[k]) - deformed.row(i)).transpose() * e.transpose();
+    length += e.norm();
   }
-  Eigen::Matrix3d frame;
-  frame.col(0) = t.normalized();
-  frame.col(2) = normal;
-  frame.col(1) = normal.cross(frame.col(0));
-  return frame;
+  length /= std::max(size, 1);
+  A += length * length * normals.row(i).transpose() * rest_normals.row(i);
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d U = svd.matrixU();
+  if ((U * svd.matrixV().transpose()).determinant() < 0.0) U.col(2) *= -1.0;
+  return U * svd.matrixV().transpose();
 }
 
 // [c - a, b - a, n] of triangle f, n the unit normal (zero for a degenerate triangle).
@@ -200,33 +209,29 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
       details_ = offset;
       break;
     case DetailMethod::Frames: {
+      // Each vertex's one-ring, except where the base's one-ring collapsed (as for the
+      // transfer's triangles): there the offset stays a plain displacement.
       const int n = detailed.num_vertices();
-      frame_neighbour_.assign(n, -1);
-      for (int f = detailed.num_faces() - 1; f >= 0; --f)  // ends with the first incident face
-        for (int k = 0; k < 3; ++k) frame_neighbour_[faces_(f, k)] = faces_(f, (k + 1) % 3);
-      // No frame where the base's one-ring collapsed (as for the transfer's triangles).
-      const Eigen::VectorXd area = lumped_mass(detailed);
-      const Eigen::VectorXd base_area = lumped_mass(TriangleMesh{base, faces_});
-      for (int i = 0; i < n; ++i) {
-        const int j = frame_neighbour_[i];
-        if (j < 0) continue;
-        const double edge = (detailed.V.row(j) - detailed.V.row(i)).norm();
-        if (!((base.row(j) - base.row(i)).norm() > kMinRelativeSize * edge &&
-              base_area[i] > kMinRelativeSize * kMinRelativeSize * area[i])) {
-          frame_neighbour_[i] = -1;
+      std::vector<std::vector<int>> rings(n);
+      for (int f = 0; f < detailed.num_faces(); ++f) {
+        for (int k = 0; k < 3; ++k) {
+          rings[faces_(f, k)].push_back(faces_(f, (k + 1) % 3));
+          rings[faces_(f, k)].push_back(faces_(f, (k + 2) % 3));
         }
       }
-      const auto normals = vertex_normals(TriangleMesh{base, faces_});
-      details_.resize(n, 3);
+      const Eigen::VectorXd area = lumped_mass(detailed);
+      const Eigen::VectorXd base_area = lumped_mass(TriangleMesh{base, faces_});
+      ring_start_.assign(n + 1, 0);
       for (int i = 0; i < n; ++i) {
-        const int j = frame_neighbour_[i];
-        const Eigen::Matrix3d frame =
-            j < 0 ? Eigen::Matrix3d::Zero()
-                  : vertex_frame(normals.row(i), (base.row(j) - base.row(i)).transpose());
-        // Where no frame exists the offset is kept as a plain displacement.
-        details_.row(i) = frame.isZero() ? Eigen::RowVector3d(offset.row(i))
-                                         : Eigen::RowVector3d(offset.row(i) * frame);
+        std::sort(rings[i].begin(), rings[i].end());
+        rings[i].erase(std::unique(rings[i].begin(), rings[i].end()), rings[i].end());
+        if (!(base_area[i] > kMinRelativeSize * kMinRelativeSize * area[i])) rings[i].clear();
+        ring_start_[i + 1] = ring_start_[i] + static_cast<int>(rings[i].size());
+        ring_.insert(ring_.end(), rings[i].begin(), rings[i].end());
       }
+      base_ = base;
+      base_normals_ = vertex_normals(TriangleMesh{base, faces_});
+      details_ = offset;
       break;
     }
     case DetailMethod::Transfer: {
@@ -322,15 +327,20 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
     case DetailMethod::Frames: {
       const auto normals = vertex_normals(TriangleMesh{s, faces_});
       Vertices out(s.rows(), 3);
-      for (Eigen::Index i = 0; i < s.rows(); ++i) {
-        const int j = frame_neighbour_[i];
-        const Eigen::Matrix3d frame =
-            j < 0 ? Eigen::Matrix3d::Zero()
-                  : vertex_frame(normals.row(i), (s.row(j) - s.row(i)).transpose());
-        out.row(i) =
-            s.row(i) + (frame.isZero() ? Eigen::RowVector3d(details_.row(i))
-                                       : Eigen::RowVector3d(details_.row(i) * frame.transpose()));
-      }
+      detail::split_in_two(s.rows(), [&](Eigen::Index begin, Eigen::Index end) {
+        for (Eigen::Index i = begin; i < end; ++i) {
+          const int size = ring_start_[i + 1] - ring_start_[i];
+          out.row(i) = s.row(i);
+          if (size == 0) {
+            out.row(i) += details_.row(i);
+          } else {
+            out.row(i) += (ring_rotation(base_, s, base_normals_, normals,
+                                         ring_.data() + ring_start_[i], size, static_cast<int>(i)) *
+                           details_.row(i).transpose())
+                              .transpose();
+          }
+        }
+      });
       return out;
     }
     case DetailMethod::Transfer:

@@ -4,9 +4,12 @@
 // Given the deformed base s', each method returns the deformed detailed mesh x':
 //  - None:         x' = s'.
 //  - Displacement: x' = s' + (x - s); details do not rotate.
-//  - Frames:       x - s in a per-vertex frame of s (vertex normal, first incident edge projected
-//                  to the tangent plane) is re-expressed in the same frame of s'. Rotates
-//                  details; can self-intersect under strong bending.
+//  - Frames:       x - s turned by the rotation of each vertex's local frame from s to s'
+//                  (the paper's section 4.4), the frame's rotation fitted to the whole one-ring
+//                  (its edge vectors and the vertex normal, by the polar decomposition): rotates
+//                  details. The paper's frame, the normal and the first incident edge, twisted
+//                  neighbouring details apart wherever that one edge turned differently from the
+//                  ring (folds at a turned handle's border: docs/results.md).
 //  - Transfer:     deformation transfer (Botsch, Sumner, Pauly & Gross 2006): per triangle the
 //                  gradient S_f = [c'-a', b'-a', n'] [c-a, b-a, n]^-1 of s -> s' (unit normals),
 //                  applied to the gradients of x; then the Poisson system K x' = G^T D [S grad x]
@@ -56,9 +59,11 @@ class DetailReconstruction {
  private:
   DetailMethod method_;
   Faces faces_;
-  Vertices details_;                  // x - s (Displacement), local coordinates (Frames)
-  std::vector<int> frame_neighbour_;  // Frames: the vertex that fixes each tangent
-  std::unique_ptr<Poisson> poisson_;  // Transfer
+  Vertices details_;                    // x - s (Displacement, Frames)
+  std::vector<int> ring_start_, ring_;  // Frames: each vertex's one-ring (empty: collapsed)
+  Vertices base_;                       // Frames: s
+  Eigen::Matrix<double, Eigen::Dynamic, 3> base_normals_;  // Frames: the vertex normals of s
+  std::unique_ptr<Poisson> poisson_;                       // Transfer
 };
 
 }  // namespace specdeform
