@@ -112,6 +112,11 @@ ear=docs/results/scenes/bunny-ear.json
   "$work/armadillo-l2.obj=$hand" "$work/bunny-l1.obj=$ear" "$work/bunny-l2.obj=$ear" \
   "$work/armadillo-l3.obj=$hand" --lanczos-below 200000
 
+echo "== Assemblies: folds at a turning handle, and a free piece that follows"
+build/bin/handle_folds >"$out/handle_folds.md"
+PYTHONPATH=build/python /usr/bin/python3 scripts/assembly_pictures.py "$work/assembly" "$out/pictures"
+node web/e2e/render.mjs "$work/assembly/jobs.json"
+
 echo "== pictures"
 jobs="["
 for f in "$work"/armadillo_* "$work"/fig6/m*_deformed.obj; do
