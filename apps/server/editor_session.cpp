@@ -333,6 +333,7 @@ void EditorSession::change_settings(std::string_view message) {
   if (auto v = word("energy")) o.energy = deform_energy_from_name(*v);
   if (auto v = word("detail")) o.detail = detail_method_from_name(*v);
   if (auto v = word("constraints")) o.constraints = constraint_mode_from_name(*v);
+  if (auto v = word("unconstrained")) o.unconstrained = unconstrained_pieces_from_name(*v);
   if (auto v = word("view")) {
     if (*v != "detailed" && *v != "base") throw InputError("settings: view is detailed or base");
     base_view = *v == "base";
@@ -349,7 +350,8 @@ void EditorSession::change_settings(std::string_view message) {
   const bool new_basis = modes != s.modes;
   const bool new_deformer = new_basis || o.energy != s.options.energy || o.ks != s.options.ks ||
                             o.kb != s.options.kb || o.detail != s.options.detail ||
-                            o.constraints != s.options.constraints;
+                            o.constraints != s.options.constraints ||
+                            o.unconstrained != s.options.unconstrained;
   if (new_deformer) {
     const PreparedBasis basis = new_basis ? compute_basis(s.rest_mesh(s.pose), modes) : s.basis();
     SpectralDeformer deformer(s.rest_mesh(s.pose), basis.harmonics, o);
@@ -525,7 +527,8 @@ void EditorSession::open_scene(const NamedFile& file) {
                    {"ks", o.ks},
                    {"kb", o.kb},
                    {"detail", name(o.detail)},
-                   {"constraints", name(o.constraints)}};
+                   {"constraints", name(o.constraints)},
+                   {"unconstrained", name(o.unconstrained)}};
   change_settings(dump(settings));
   set_edit(std::move(edit), true, true);
 }
@@ -610,6 +613,7 @@ void EditorSession::send_ready() {
                            {"kb", s.options.kb},
                            {"detail", name(s.options.detail)},
                            {"constraints", name(s.options.constraints)},
+                           {"unconstrained", name(s.options.unconstrained)},
                            {"view", s.base_view ? "base" : "detailed"}}},
                          {"basis",
                           {{"seconds", b.seconds},
@@ -645,7 +649,6 @@ void EditorSession::send_state() {
                      {"selection_seconds", s.selection_seconds},
                      {"pin_error", s.pin_error},
                      {"free_pieces", s.has_handles ? s.deformer->free_pieces() : 0},
-                     {"unconstrained", name(s.options.unconstrained)},
                      {"constrained_piece_modes",
                       s.has_handles ? s.deformer->constrained_piece_modes() : std::vector<int>()},
                      {"pose", s.pose}}));

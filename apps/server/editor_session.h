@@ -8,7 +8,8 @@
 //     {"type": "hello"}              everything again (a new connection)
 //     {"type": "settings", "modes": m, "energy": "linear|arap", "ks": x, "kb": x,
 //      "detail": "none|displacement|frames|transfer", "constraints": "soft|hard",
-//      "view": "detailed|base"}      any subset; answered with "ready" (also when rejected)
+//      "unconstrained": "follow|keep|error", "view": "detailed|base"}
+//                                    any subset; answered with "ready" (also when rejected)
 //     {"type": "open_demo"}          the built-in bumpy bar
 //     {"type": "commit"}             the transforms as they are now become an undo step
 //     {"type": "undo"}, {"type": "redo"}
@@ -24,7 +25,7 @@
 //      "setup": {...}, "arap_clusters"}         after a mesh message or a settings request
 //     {"type": "state", "request": the request's type ("open": the server's first mesh),
 //      "groups": [{"vertices", "pinned", "transform": 16 numbers}], "fixed",
-//      "undo", "redo", "selection_seconds", "pin_error", "free_pieces", "unconstrained",
+//      "undo", "redo", "selection_seconds", "pin_error", "free_pieces",
 //      "constrained_piece_modes", "pose"}
 //                                               after every edit, last (its frame comes first)
 //     {"type": "empty", "request"}              no mesh is open (a failed or cancelled start)

@@ -204,7 +204,8 @@ TEST_F(EditorSessionTest, EverySettingsRequestEndsInReady) {
   for (const std::string bad :
        {R"({"type": "settings", "kb": 0})", R"({"type": "settings", "modes": -3})",
         R"({"type": "settings", "detail": "sparkles"})",
-        R"({"type": "settings", "energy": "elastic"})"}) {
+        R"({"type": "settings", "energy": "elastic"})",
+        R"({"type": "settings", "unconstrained": "drift"})"}) {
     sent_.clear();
     session_->handle(false, bad);
     EXPECT_EQ(text_types(), (std::vector<std::string>{"error", "ready"})) << bad;
@@ -215,12 +216,14 @@ TEST_F(EditorSessionTest, EverySettingsRequestEndsInReady) {
   for (const std::string good :
        {R"({"type": "settings", "kb": 1})", R"({"type": "settings", "kb": 2})",
         R"({"type": "settings", "constraints": "hard"})",
-        R"({"type": "settings", "constraints": "soft"})"}) {
+        R"({"type": "settings", "constraints": "soft"})",
+        R"({"type": "settings", "unconstrained": "keep"})"}) {
     sent_.clear();
     session_->handle(false, good);
     EXPECT_EQ(text_types(), std::vector<std::string>{"ready"}) << good;
   }
   EXPECT_EQ(last_text("ready")["settings"]["kb"], 2.0);
+  EXPECT_EQ(last_text("ready")["settings"]["unconstrained"], "keep");
 }
 
 TEST_F(EditorSessionTest, SettingsRebuildAndKeepTheSelection) {

@@ -91,7 +91,7 @@ export class Panel {
         if (Number.isFinite(v)) s.request({ type: 'settings', [id]: v }, 'settings', 'ready');
       });
     }
-    for (const id of ['energy', 'detail', 'constraints']) {
+    for (const id of ['energy', 'detail', 'constraints', 'unconstrained']) {
       $(id).addEventListener('change', (e) =>
         s.request({ type: 'settings', [id]: (e.target as HTMLSelectElement).value } as P.ClientText, 'settings', 'ready'));
     }
@@ -271,7 +271,7 @@ export class Panel {
     $('counts').textContent = r && editable
       ? `handles: ${c.handles.toLocaleString()} vertices in ${c.groups} group${c.groups === 1 ? '' : 's'} · ` +
         `fixed: ${c.fixed.toLocaleString()} · pinned: ${c.pinned.toLocaleString()}` +
-        (s.server?.free_pieces ? ` · ${s.server.free_pieces} piece(s) without handles ${s.server.unconstrained === 'keep' ? 'held in place' : 'follow the surface'}` : '') +
+        (s.server?.free_pieces ? ` · ${s.server.free_pieces} piece(s) without handles ${s.ready?.settings.unconstrained === 'keep' ? 'held in place' : 'follow the surface'}` : '') +
         ((s.server?.constrained_piece_modes?.length ?? 0) > 1 ? ` · modes per constrained piece: ${s.server!.constrained_piece_modes.join(', ')}` : '')
       : '';
     this.renderNotes();
@@ -293,7 +293,7 @@ export class Panel {
       : phase.kind === 'empty' ? 'no mesh open' : phase.kind === 'loading' ? 'preparing the mesh…' : 'connecting…';
     const enable = (id: string, on: boolean) => ($<HTMLButtonElement>(id).disabled = !on);
     for (const id of ['undo', 'redo', 'reset', 'apply-pose', 'export-mesh', 'export-scene', 'clear', 'new-group',
-      'energy', 'ks', 'kb', 'detail', 'constraints', 'modes', 'show-base', 'group', 'export-format', 'gizmo-translate',
+      'energy', 'ks', 'kb', 'detail', 'constraints', 'unconstrained', 'modes', 'show-base', 'group', 'export-format', 'gizmo-translate',
       'gizmo-rotate', 'gizmo-scale', 'pivot', 'select-linked', 'select-invert', 'select-grow', 'select-shrink', 'select-box', 'xray']) {
       enable(id, editable);
     }
@@ -341,7 +341,7 @@ export class Panel {
     const r = this.s.ready;
     if (!r) {
       // Nothing known yet: placeholders, not a default that looks like a setting.
-      for (const id of ['modes', 'energy', 'ks', 'kb', 'detail', 'constraints']) $<HTMLInputElement>(id).value = '';
+      for (const id of ['modes', 'energy', 'ks', 'kb', 'detail', 'constraints', 'unconstrained']) $<HTMLInputElement>(id).value = '';
       $<HTMLInputElement>('show-base').checked = false;
       return this.renderModes();
     }
@@ -351,6 +351,7 @@ export class Panel {
     $<HTMLInputElement>('kb').value = String(r.settings.kb);
     $<HTMLSelectElement>('detail').value = r.settings.detail;
     $<HTMLSelectElement>('constraints').value = r.settings.constraints;
+    $<HTMLSelectElement>('unconstrained').value = r.settings.unconstrained;
     $<HTMLInputElement>('show-base').checked = r.settings.view === 'base';
     this.renderModes();
   }

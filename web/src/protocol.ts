@@ -23,6 +23,7 @@ export type Matrix = number[]; // 4 x 4, row-major
 export type Energy = 'linear' | 'arap';
 export type Detail = 'none' | 'displacement' | 'frames' | 'transfer';
 export type Constraints = 'soft' | 'hard';
+export type Unconstrained = 'follow' | 'keep' | 'error';
 export type View = 'detailed' | 'base';
 
 export interface Settings {
@@ -31,6 +32,7 @@ export interface Settings {
   kb: number;
   detail: Detail;
   constraints: Constraints;
+  unconstrained: Unconstrained; // pieces without a handle or fixed vertex
   view: View;
 }
 
@@ -74,7 +76,6 @@ export interface StateMessage {
   selection_seconds: number;
   pin_error: number;
   free_pieces: number; // pieces without a constrained vertex
-  unconstrained: 'follow' | 'keep' | 'error'; // what they do
   constrained_piece_modes: number[]; // the basis's modes on each piece with a handle or fixed vertex
   pose: number;
 }
