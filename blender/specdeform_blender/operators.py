@@ -185,6 +185,7 @@ def _finish(obj, r, job):
             basis=(evals, evecs),
             energy=s.energy,
             detail=s.detail,
+            unconstrained=s.unconstrained,
             constraint_weight=s.constraint_weight,
         )
         d.set_selection(handles=[r.handle], fixed=r.fixed)

@@ -51,6 +51,15 @@ class SpecdeformSettings(bpy.types.PropertyGroup):
         ),
         default="transfer",
     )
+    unconstrained: EnumProperty(
+        name="Free pieces",
+        description="Loose parts without a handle or fixed vertex",
+        items=(
+            ("follow", "Follow", "Move rigidly with the deformed surface around them"),
+            ("keep", "Keep", "Stay where they are"),
+        ),
+        default="follow",
+    )
     constraint_weight: FloatProperty(
         name="Weight",
         description="Soft constraint weight (on the mesh scaled to unit area)",

@@ -30,6 +30,7 @@ class VIEW3D_PT_specdeform(bpy.types.Panel):
         col.prop(s, "modes")
         col.prop(s, "energy")
         col.prop(s, "detail")
+        col.prop(s, "unconstrained")
         col.prop(s, "constraint_weight")
         row = layout.row(align=True)
         row.operator("specdeform.bind")

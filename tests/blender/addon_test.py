@@ -1,5 +1,5 @@
 """The add-on in Blender, headless: bind, move the target, compare with `specdeform deform` on
-the same mesh and selection, unbind, apply, bad groups, polygons.
+the same mesh and selection, unbind, apply, bad groups, polygons, loose parts.
 
     blender -b --factory-startup --python-exit-code 1 --python addon_test.py -- SCENE
 SCENE: generated (the built-in bumpy bar, twisted 90 degrees), twisted-bar (the shared
@@ -186,6 +186,34 @@ def check_polygons():
     assert np.array_equal(support.evaluated(obj), co)
 
 
+def check_loose_parts():
+    """A loose ring around the bar follows it (rigidly) by default and stays with Keep."""
+    Vb, Fb = specdeform.bumpy_bar(cells_per_unit=8)
+    Vr, Fr = specdeform.torus(0.8, 0.07, 32, 8)
+    Vr = Vr @ np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0]], float).T
+    Vr[:, 0] += 3.0
+    V, F = np.vstack([Vb, Vr]), np.vstack([Fb, Fr + len(Vb)])
+    handle, fixed = np.flatnonzero(Vb[:, 0] > 3.6), np.flatnonzero(Vb[:, 0] < 0.4)
+    c, s = math.cos(0.8), math.sin(0.8)
+    T = np.array([[c, -s, 0, 4 - 4 * c], [s, c, 0, -4 * s], [0, 0, 1, 0], [0, 0, 0, 1]])
+    obj, empty = support.add_object("loose", V, F, handle, fixed)
+    rest = support.evaluated(obj)
+    ring = slice(len(Vb), len(V))
+    moved = {}
+    for mode in ("follow", "keep"):
+        obj.specdeform.unconstrained = mode
+        bind(obj)
+        support.move(empty, T)
+        X = support.evaluated(obj)
+        d, d0 = X[ring] - X[len(Vb)], rest[ring] - rest[len(Vb)]
+        assert np.abs(np.linalg.norm(d, axis=1) - np.linalg.norm(d0, axis=1)).max() < 1e-4
+        moved[mode] = np.abs(X[ring] - rest[ring]).max()
+        assert bpy.ops.specdeform.unbind() == {"FINISHED"}
+        support.move(empty, np.eye(4))
+    print(f"loose ring moved: follow {moved['follow']:.3f}, keep {moved['keep']:.1e}")
+    assert moved["follow"] > 0.3 and moved["keep"] < 1e-6, moved
+
+
 def main():
     scene = twisted_bar_scene() if SCENE == "twisted-bar" else generated_scene()
     support.fresh_file()
@@ -196,6 +224,7 @@ def main():
         check_cancel(obj)
         if SCENE == "generated":
             check_polygons()
+            check_loose_parts()
     print("passed")
 
 
