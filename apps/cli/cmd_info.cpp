@@ -36,7 +36,7 @@ void add_info_command(CLI::App& app) {
     j["bbox_diagonal"] = i.bbox_diagonal;
     j["non_manifold_edges"] = i.non_manifold_edges;
     j["degenerate_faces"] = i.degenerate_faces;
-    j["duplicate_faces"] = i.duplicate_faces;
+    j["duplicate_faces"] = loaded.info.duplicate_faces + i.duplicate_faces;  // dropped on reading
     // Defects, their first vertex in the file's numbering (null: none).
     const auto file_vertex = [&](int v) {
       return v < 0 ? nlohmann::ordered_json()

@@ -139,6 +139,10 @@ LoadedMesh load_mesh(const std::string& path) {
     std::cerr << path << ": note: " << info.collapsed_faces
               << " faces repeating a vertex were dropped\n";
   }
+  if (info.duplicate_faces > 0) {
+    std::cerr << path << ": note: " << info.duplicate_faces
+              << " faces on the same three vertices as an earlier face were dropped\n";
+  }
   return loaded;
 }
 

@@ -79,6 +79,8 @@ void bind_mesh(py::module_& m) {
                     "File vertices no face uses (dropped).")
       .def_readonly("collapsed_faces", &MeshReadInfo::collapsed_faces,
                     "Triangles that repeat a vertex (dropped).")
+      .def_readonly("duplicate_faces", &MeshReadInfo::duplicate_faces,
+                    "Triangles on the same three vertices as an earlier one (dropped).")
       .def_readonly("welded_corners", &MeshReadInfo::welded_corners,
                     "STL: triangle corners merged into an existing vertex.")
       .def("__repr__", [](const MeshReadInfo& i) {
@@ -86,6 +88,7 @@ void bind_mesh(py::module_& m) {
                ", file_faces=" + std::to_string(i.file_faces) +
                ", unused_vertices=" + std::to_string(i.unused_vertices) +
                ", collapsed_faces=" + std::to_string(i.collapsed_faces) +
+               ", duplicate_faces=" + std::to_string(i.duplicate_faces) +
                ", welded_corners=" + std::to_string(i.welded_corners) + ")";
       });
 

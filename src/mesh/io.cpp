@@ -1,6 +1,7 @@
 #include "specdeform/mesh/io.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <charconv>
 #include <cmath>
@@ -107,6 +108,33 @@ LoadedMesh build_mesh(PolygonSoup soup, const std::string& name) {
       tris.insert(tris.end(), {a, b, d});
       info.face_to_file.push_back(p);
     }
+  }
+  // Triangles on the same three vertices as an earlier one: sorted by their sorted corners, each
+  // run of equal ones keeps its first.
+  {
+    const size_t count = tris.size() / 3;
+    std::vector<std::array<int, 3>> key(count);
+    for (size_t f = 0; f < count; ++f) {
+      key[f] = {tris[3 * f], tris[3 * f + 1], tris[3 * f + 2]};
+      std::sort(key[f].begin(), key[f].end());
+    }
+    std::vector<size_t> order(count);
+    std::iota(order.begin(), order.end(), size_t{0});
+    std::sort(order.begin(), order.end(),
+              [&](size_t a, size_t b) { return key[a] != key[b] ? key[a] < key[b] : a < b; });
+    std::vector<char> keep(count, 1);
+    for (size_t i = 1; i < count; ++i) {
+      if (key[order[i]] == key[order[i - 1]]) keep[order[i]] = 0;
+    }
+    size_t kept = 0;
+    for (size_t f = 0; f < count; ++f) {
+      if (!keep[f]) continue;
+      for (int c = 0; c < 3; ++c) tris[3 * kept + c] = tris[3 * f + c];
+      info.face_to_file[kept++] = info.face_to_file[f];
+    }
+    info.duplicate_faces = static_cast<int>(count - kept);
+    tris.resize(3 * kept);
+    info.face_to_file.resize(kept);
   }
   if (tris.empty()) {
     throw InputError(name + (info.collapsed_faces > 0

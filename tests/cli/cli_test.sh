@@ -79,6 +79,12 @@ awk -v f="$faces" 'NR==2{$2=f+1} {print} END{}' "$tmp/p.off" >"$tmp/dup.off"
 tail -1 "$tmp/p.off" >>"$tmp/dup.off"
 expect 0 "$bin" info "$tmp/dup.off" --json
 grep -q '"duplicate_faces":1' "$tmp/out" || { echo "FAIL: info does not report the duplicated face: $(cat "$tmp/out")"; fails=$((fails + 1)); }
+# deform drops the duplicate with a note: the same vertices as without it.
+expect 0 "$bin" deform "$tmp/p.off" --scene "$tmp/scene.json" -m 30 -o "$tmp/plain.off"
+expect 0 "$bin" deform "$tmp/dup.off" --scene "$tmp/scene.json" -m 30 -o "$tmp/dup_out.off"
+grep -q "faces on the same three vertices as an earlier face were dropped" "$tmp/err" || { echo "FAIL: no note of the dropped duplicate: $(cat "$tmp/err")"; fails=$((fails + 1)); }
+vertices=$(sed -n 2p "$tmp/p.off" | awk '{print $1}')
+cmp -s <(head -n $((vertices + 2)) "$tmp/plain.off" | tail -n "$vertices") <(head -n $((vertices + 2)) "$tmp/dup_out.off" | tail -n "$vertices") || { echo "FAIL: a duplicated face changed the result"; fails=$((fails + 1)); }
 # A scene that names its mesh, read without MESH.
 printf '{"mesh": "p.off", "handles": [{"vertices": [288], "transform": {"translate": [0, 0, 0.2]}}], "fixed": [0, 1]}' >"$tmp/named.json"
 expect 0 "$bin" deform --scene "$tmp/named.json" -m 30 -o "$tmp/named.off"

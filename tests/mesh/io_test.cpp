@@ -289,6 +289,18 @@ TEST(MeshIo, FacesRepeatingAVertexAreDropped) {
   EXPECT_EQ(m.info.collapsed_faces, 1);
 }
 
+// A face on the same three vertices as an earlier one, in any order (a doubled face, or the
+// other side of a two-sided sheet), is dropped: it would count its area and stiffness twice.
+TEST(MeshIo, DuplicateFacesAreDropped) {
+  const LoadedMesh m =
+      parse("OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n3 2 1 0\n3 0 2 1\n",
+            MeshFormat::Off);
+  EXPECT_EQ(m.mesh.num_faces(), 2);
+  EXPECT_EQ(m.info.duplicate_faces, 2);
+  EXPECT_EQ(m.info.face_to_file, (std::vector<int>{0, 1}));
+  EXPECT_EQ(m.mesh.F.row(1), Eigen::RowVector3i(1, 3, 2));
+}
+
 TEST(MeshIo, ClearErrors) {
   expect_error("", MeshFormat::Off, "empty file");
   expect_error("OFF\n", MeshFormat::Off, "unexpected end of file");

@@ -50,6 +50,9 @@ struct MeshReadInfo {
   std::vector<int> face_to_file;    // mesh triangle f comes from file polygon face_to_file[f]
   int unused_vertices = 0;          // file vertices no face uses (dropped)
   int collapsed_faces = 0;          // triangles that repeat a vertex (dropped)
+  int duplicate_faces = 0;          // triangles on the same three vertices as an earlier one,
+                                    // in any order (dropped: a doubled face would count its
+                                    // area and stiffness twice)
   int welded_corners = 0;           // STL: triangle corners merged into an existing vertex
 };
 
