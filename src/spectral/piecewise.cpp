@@ -48,6 +48,10 @@ std::vector<int> piece_modes(const std::vector<double>& area, const std::vector<
     sum -= modes[by_area[k]] - 1;
     modes[by_area[k]] = 1;
   }
+  for (size_t k = 0; k < count && sum > limit; ++k) {
+    --sum;
+    modes[by_area[k]] = 0;
+  }
   return modes;
 }
 
@@ -76,6 +80,10 @@ Spectrum solve_by_piece(const Sparse& K, const Sparse& M, const Sparse* lengths,
   int done = 0;
   for (int c = 0; c < count; ++c) {
     for (int k = 0; k < vertices[c]; ++k) local[index[c][k]] = k;
+    if (modes[c] == 0) {
+      done += vertices[c];
+      continue;
+    }
     ManifoldHarmonicsOptions piece = o;
     piece.num_modes = modes[c];
     if (o.progress) {

@@ -143,5 +143,40 @@ TEST(FreePieces, ARingRidesAlongWithTheBarItSitsOn) {
   EXPECT_GT(gap_change[1], 5 * gap_change[0]);
 }
 
+// A scan's specks: 200 stray triangles around a bar at m = 10. The basis keeps to 16 m columns
+// (the bar's 16, then a constant for the largest specks, none for the 56 smallest), and every
+// speck, with modes or without, rides along rigidly.
+TEST(FreePieces, SpecksWithoutModesFollowToo) {
+  BumpyBarOptions bar_options;
+  bar_options.cells_per_unit = 6;
+  TriangleMesh mesh = make_bumpy_bar(bar_options);
+  const int n = mesh.num_vertices();
+  for (int k = 0; k < 200; ++k) {
+    const double x = 0.1 + 0.019 * k, size = 0.002 + 0.0001 * k;
+    TriangleMesh speck{Vertices(3, 3), Faces(1, 3)};
+    speck.V << x, 0.6, 0.0, x + size, 0.6, 0.0, x, 0.6 + size, size;
+    speck.F << 0, 1, 2;
+    mesh = test::concatenate(mesh, speck);
+  }
+  const auto h = harmonics(mesh, 10);
+  EXPECT_EQ(h->pieces, 201);
+  EXPECT_EQ(h->basis.cols(), 160);
+  Selection selection;
+  selection.handles.resize(1);
+  for (int v = 0; v < n; ++v) {
+    if (mesh.V(v, 0) < 0.4) selection.fixed.push_back(v);
+    if (mesh.V(v, 0) > 3.6) selection.handles[0].push_back(v);
+  }
+  SpectralDeformer deformer(mesh, h);
+  deformer.set_selection(selection);
+  EXPECT_EQ(deformer.free_pieces(), 200);
+  const Vertices out = deformer.solve({Eigen::Affine3d(Eigen::Translation3d(0, 0, 0.5)) *
+                                       Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX())});
+  ASSERT_TRUE(out.allFinite());
+  const Eigen::VectorXi label = vertex_components(mesh);
+  for (int c = 1; c <= 200; ++c) EXPECT_LT(rigidity_error(mesh.V, out, label, c), 1e-12) << c;
+  EXPECT_GT((out.bottomRows(600) - mesh.V.bottomRows(600)).cwiseAbs().maxCoeff(), 0.05);
+}
+
 }  // namespace
 }  // namespace specdeform

@@ -41,6 +41,12 @@ TEST(PieceModes, ShareOfTheAreaWithAFloorAndALimit) {
       detail::piece_modes(std::vector<double>(300, 1.0), std::vector<int>(300, 500), 100, policy);
   EXPECT_LE(std::accumulate(many.begin(), many.end(), 0), 1600);
   EXPECT_EQ(std::count(many.begin(), many.end(), 16), 86);
+  // 2,000 specks: 1,600 keep their constant, the 400 smallest none.
+  std::vector<double> specks(2000);
+  std::iota(specks.begin(), specks.end(), 1.0);
+  const std::vector<int> few = detail::piece_modes(specks, std::vector<int>(2000, 3), 100, policy);
+  EXPECT_EQ(std::accumulate(few.begin(), few.end(), 0), 1600);
+  EXPECT_EQ(std::count(few.begin(), few.begin() + 400, 0), 400);
 }
 
 // 100 identical spheres at m = 1000: eigenvalues of multiplicity 100 to 700 (the whole mesh's
