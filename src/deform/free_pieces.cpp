@@ -2,27 +2,14 @@
 
 #include <algorithm>
 
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/AABB_triangle_primitive.h>
-#include <CGAL/Simple_cartesian.h>
 #include <Eigen/SVD>
 
+#include "mesh/triangle_tree.h"
 #include "specdeform/exceptions.h"
 
 namespace specdeform::detail {
 
 namespace {
-
-using Kernel = CGAL::Simple_cartesian<double>;
-using Point = Kernel::Point_3;
-using Triangle = Kernel::Triangle_3;
-using Primitive = CGAL::AABB_triangle_primitive<Kernel, std::vector<Triangle>::const_iterator>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
-
-Point point(const Vertices& V, Eigen::Index i) {
-  return {V(i, 0), V(i, 1), V(i, 2)};
-}
 
 // Barycentric coordinates of p (on or near the triangle's plane) in the triangle (a, b, c).
 Eigen::Vector3d barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
@@ -67,12 +54,12 @@ FreePieces::FreePieces(const TriangleMesh& mesh, const Eigen::VectorXi& componen
   for (int v = 0; v < mesh.num_vertices(); ++v) {
     if (piece_of[components[v]] >= 0) pieces_[piece_of[components[v]]].vertices.push_back(v);
   }
-  std::vector<Triangle> triangles;
+  std::vector<TreeTriangle> triangles;
   std::vector<int> face_of;
   for (int f = 0; f < mesh.num_faces(); ++f) {
     if (!driving[components[mesh.F(f, 0)]]) continue;
-    const Triangle t(point(mesh.V, mesh.F(f, 0)), point(mesh.V, mesh.F(f, 1)),
-                     point(mesh.V, mesh.F(f, 2)));
+    const TreeTriangle t(tree_point(mesh.V, mesh.F(f, 0)), tree_point(mesh.V, mesh.F(f, 1)),
+                         tree_point(mesh.V, mesh.F(f, 2)));
     if (t.is_degenerate()) continue;
     triangles.push_back(t);
     face_of.push_back(f);
@@ -80,7 +67,7 @@ FreePieces::FreePieces(const TriangleMesh& mesh, const Eigen::VectorXi& componen
   if (triangles.empty()) {
     throw InputError("free pieces: the constrained pieces have no triangle to follow");
   }
-  Tree tree(triangles.begin(), triangles.end());
+  TriangleTree tree(triangles.begin(), triangles.end());
   tree.accelerate_distance_queries();
   for (Piece& piece : pieces_) {
     Eigen::AlignedBox3d box;
@@ -90,7 +77,7 @@ FreePieces::FreePieces(const TriangleMesh& mesh, const Eigen::VectorXi& componen
     const size_t samples = std::min<size_t>(count, policy.samples);
     for (size_t s = 0; s < samples; ++s) {
       const int v = piece.vertices[s * count / samples];
-      const auto [q, it] = tree.closest_point_and_primitive(point(mesh.V, v));
+      const auto [q, it] = tree.closest_point_and_primitive(tree_point(mesh.V, v));
       const int f = face_of[it - triangles.cbegin()];
       const Eigen::Vector3d closest(q.x(), q.y(), q.z());
       const double d = (closest - mesh.V.row(v).transpose()).norm() + softening;

@@ -56,17 +56,8 @@ TEST(FreePieces, FollowTheSurfaceAroundThemAndKeepTheirGap) {
     if (m.category != test::Category::Components) continue;
     int pieces = 0;
     const Eigen::VectorXi label = vertex_components(m.mesh, &pieces);
-    std::vector<int> piece;
-    for (int v = 0; v < m.mesh.num_vertices(); ++v)
-      if (label[v] == 0) piece.push_back(v);
-    std::sort(piece.begin(), piece.end(),
-              [&](int a, int b) { return m.mesh.V(a, 2) < m.mesh.V(b, 2); });
-    const size_t tenth = std::max<size_t>(1, piece.size() / 10);
-    const Selection selection{{{piece.end() - tenth, piece.end()}},
-                              {piece.begin(), piece.begin() + tenth}};
+    const auto [selection, T] = test::first_piece_scene(m.mesh, label);
     const double diagonal = bounding_box_diagonal(m.mesh.V);
-    const Eigen::Affine3d T = Eigen::Translation3d(0.0, 0.05 * diagonal, 0.1 * diagonal) *
-                              Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX());
     const auto h = harmonics(m.mesh, 100);
     for (const DetailMethod method : {DetailMethod::Displacement, DetailMethod::Transfer}) {
       DeformOptions o;

@@ -1,5 +1,7 @@
 #include "support/corpus.h"
 
+#include <algorithm>
+
 #include "specdeform/mesh/generate.h"
 
 namespace specdeform::test {
@@ -11,6 +13,18 @@ TriangleMesh concatenate(const TriangleMesh& a, const TriangleMesh& b) {
   out.F.resize(a.F.rows() + b.F.rows(), 3);
   out.F << a.F, (b.F.array() + static_cast<int>(a.V.rows())).matrix();
   return out;
+}
+
+PieceScene first_piece_scene(const TriangleMesh& mesh, const Eigen::VectorXi& label) {
+  std::vector<int> piece;
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    if (label[v] == 0) piece.push_back(v);
+  std::sort(piece.begin(), piece.end(), [&](int a, int b) { return mesh.V(a, 2) < mesh.V(b, 2); });
+  const size_t tenth = std::max<size_t>(1, piece.size() / 10);
+  const double diagonal = bounding_box_diagonal(mesh.V);
+  return {{{{piece.end() - tenth, piece.end()}}, {piece.begin(), piece.begin() + tenth}},
+          Eigen::Translation3d(0.0, 0.05 * diagonal, 0.1 * diagonal) *
+              Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX())};
 }
 
 namespace {

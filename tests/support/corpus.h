@@ -7,6 +7,9 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
+#include "specdeform/deform/selection.h"
 #include "specdeform/mesh/triangle_mesh.h"
 
 namespace specdeform::test {
@@ -28,5 +31,14 @@ std::filesystem::path shared_dir();
 
 // Two meshes side by side as one (vertex indices of `b` shifted).
 TriangleMesh concatenate(const TriangleMesh& a, const TriangleMesh& b);
+
+// The assemblies' scene: the highest tenth (along z) of piece 0 (`label` from
+// vertex_components) lifted by 0.1 and moved by 0.05 diagonals and turned by 0.4 rad about x,
+// its lowest tenth fixed; the other pieces free.
+struct PieceScene {
+  Selection selection;
+  Eigen::Affine3d transform;
+};
+PieceScene first_piece_scene(const TriangleMesh& mesh, const Eigen::VectorXi& label);
 
 }  // namespace specdeform::test
