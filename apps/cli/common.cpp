@@ -212,6 +212,10 @@ void SceneArgs::add_to(CLI::App& cmd) {
   auto* dmat_opt = cmd.add_option("--dmat", dmat, "libigl selection (-1 free, k handle group k)");
   auto* def_opt = cmd.add_option("--def", def, "handle transforms: 4x4 row-major, one per group");
   auto* scene_opt = cmd.add_option("--scene", scene, "JSON scene (see docs/scene.md)");
+  cmd.add_option("--influence", influence,
+                 "hold the surface farther than this fraction of the diagonal from the handles "
+                 "(along the surface; overrides the scene's)")
+      ->check(kPositive);
   sel_opt->excludes(dmat_opt)->excludes(scene_opt)->needs(def_opt);
   dmat_opt->excludes(scene_opt)->needs(def_opt);
   def_opt->excludes(scene_opt);
@@ -244,7 +248,8 @@ LoadedScene load_scene(const std::string& mesh_path, const SceneArgs& args,
                             : !args.sel.empty() ? args.sel
                                                 : args.dmat;
   std::vector<std::string> notes;
-  out.selection = to_mesh_numbering(out.scene.selection, info, &notes, name);
+  if (args.influence > 0.0) out.scene.influence = args.influence;
+  out.selection = scene_selection(out.scene, out.mesh, &notes, name);
   for (const std::string& note : notes) std::cerr << name << ": note: " << note << "\n";
   return out;
 }

@@ -64,6 +64,7 @@ struct TableOutputs {
 
 struct SceneArgs {
   std::string sel, def, dmat, scene;
+  double influence = 0.0;  // --influence: the scene's region of influence (0: the scene's)
   void add_to(CLI::App& cmd);
 };
 

@@ -514,7 +514,7 @@ void EditorSession::open_scene(const NamedFile& file) {
   }
   std::filesystem::remove(path);
   GroupSelection edit;
-  edit.selection = to_mesh_numbering(scene.selection, s.loaded.info);
+  edit.selection = scene_selection(scene, s.loaded);
   edit.transforms = match_transforms(edit.selection, scene.transforms);
   edit.pinned.assign(edit.selection.handles.size(), false);
   // The scene's settings, as a settings request would set them.

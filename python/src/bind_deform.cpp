@@ -70,8 +70,7 @@ py::dict read_scene_files(const std::filesystem::path& path, const std::filesyst
     }
   }
   std::vector<std::string> notes;
-  const Selection selection =
-      to_mesh_numbering(scene.selection, loaded.info, &notes, path.string());
+  const Selection selection = scene_selection(scene, loaded, &notes, path.string());
   py::list handles, matrices;
   for (const std::vector<int>& group : selection.handles) handles.append(index_array(group));
   for (const Eigen::Affine3d& t : match_transforms(scene.selection, scene.transforms)) {

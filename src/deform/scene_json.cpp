@@ -186,7 +186,7 @@ class SceneReader {
   }
 
   Scene read(const Field& root, const DeformOptions& defaults) const {
-    root.object({"mesh", "handles", "fixed", "settings"});
+    root.object({"mesh", "handles", "fixed", "influence", "settings"});
     Scene scene;
     scene.options = defaults;
     if (root.has("mesh")) scene.mesh = dir_ / root["mesh"].string();
@@ -208,6 +208,10 @@ class SceneReader {
       scene.selection.handles.push_back(std::move(vertices));
     }
     if (root.has("fixed")) scene.selection.fixed = fixed(root["fixed"], scene.selection);
+    if (root.has("influence")) {
+      scene.influence = root["influence"].number();
+      if (!(*scene.influence > 0)) root["influence"].fail("the radius must be > 0");
+    }
     if (root.has("settings")) read_settings(root["settings"], scene);
     return scene;
   }
@@ -398,7 +402,7 @@ Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertice
 std::filesystem::path scene_mesh(const std::filesystem::path& path) {
   const Json j = parse_json(detail::read_scene_file(path), path.string());
   const Field root(j, path.string());
-  root.object({"mesh", "handles", "fixed", "settings"});
+  root.object({"mesh", "handles", "fixed", "influence", "settings"});
   return root.has("mesh") ? path.parent_path() / root["mesh"].string() : std::filesystem::path();
 }
 
@@ -415,6 +419,7 @@ std::string encode_scene(const Scene& scene) {
     j["handles"].push_back({{"vertices", scene.selection.handles[g]}, {"transform", rows}});
   }
   j["fixed"] = scene.selection.fixed;
+  if (scene.influence) j["influence"] = *scene.influence;
   const DeformOptions& o = scene.options;
   Json settings = {{"energy", name(o.energy)},
                    {"ks", o.ks},

@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "scene_internal.h"
+#include "specdeform/deform/influence.h"
 #include "specdeform/deform/scene.h"
 #include "specdeform/exceptions.h"
 
@@ -94,6 +95,13 @@ Scene benchmark_scene(const TriangleMesh& mesh) {
   move[axes[1]] = 0.1 * extent.norm();
   s.transforms = {Eigen::Affine3d(Eigen::Translation3d(move))};
   return s;
+}
+
+Selection scene_selection(const Scene& scene, const LoadedMesh& mesh,
+                          std::vector<std::string>* notes, std::string_view name) {
+  Selection out = to_mesh_numbering(scene.selection, mesh.info, notes, name);
+  if (!scene.influence) return out;
+  return limit_influence(mesh.mesh, out, *scene.influence * bounding_box_diagonal(mesh.mesh.V));
 }
 
 Selection to_mesh_numbering(const Selection& selection, const MeshReadInfo& info,

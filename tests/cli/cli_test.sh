@@ -85,6 +85,9 @@ expect 0 "$bin" deform "$tmp/dup.off" --scene "$tmp/scene.json" -m 30 -o "$tmp/d
 grep -q "faces on the same three vertices as an earlier face were dropped" "$tmp/err" || { echo "FAIL: no note of the dropped duplicate: $(cat "$tmp/err")"; fails=$((fails + 1)); }
 vertices=$(sed -n 2p "$tmp/p.off" | awk '{print $1}')
 cmp -s <(head -n $((vertices + 2)) "$tmp/plain.off" | tail -n "$vertices") <(head -n $((vertices + 2)) "$tmp/dup_out.off" | tail -n "$vertices") || { echo "FAIL: a duplicated face changed the result"; fails=$((fails + 1)); }
+# A region of influence: the far end stays exactly; a radius that is not positive is refused.
+expect 0 "$bin" deform "$tmp/p.off" --scene "$tmp/scene.json" -m 30 --influence 0.2 -o "$tmp/near.off"
+expect 2 "$bin" deform "$tmp/p.off" --scene "$tmp/scene.json" -m 30 --influence -1 -o "$tmp/x.off"
 # A scene that names its mesh, read without MESH.
 printf '{"mesh": "p.off", "handles": [{"vertices": [288], "transform": {"translate": [0, 0, 0.2]}}], "fixed": [0, 1]}' >"$tmp/named.json"
 expect 0 "$bin" deform --scene "$tmp/named.json" -m 30 -o "$tmp/named.off"

@@ -140,6 +140,9 @@ TEST_F(SceneFiles, FieldsOfTheWrongTypeNameThemselves) {
        "settings unconstrained: unknown unconstrained-pieces policy 'drop' (follow, keep or "
        "error)"},
       {R"({"handles": [{"vertices": [0]}], "settings": {"kb": -1}})", "ks and kb"},
+      {R"({"handles": [{"vertices": [0]}], "influence": 0})", "influence: the radius must be > 0"},
+      {R"({"handles": [{"vertices": [0]}], "influence": "far"})",
+       "influence: expected a number, got a string"},
       {R"({"handles": [{"vertices": [0]}], "setings": {}})", "unknown key 'setings'"},
       {R"({"mesh": 3, "handles": [{"vertices": [0]}]})", "mesh: expected a string, got a number"},
       {R"({"mesh": "a\nb.off", "handles": [{"vertices": [0]}]})",
@@ -158,7 +161,8 @@ TEST_F(SceneFiles, FieldsOfTheWrongTypeNameThemselves) {
 
 TEST_F(SceneFiles, AllSettingsReadAndWritten) {
   const Vertices V = Eigen::MatrixX3d::Random(4, 3);
-  const Scene s = read_scene(write("s.json", R"({"handles": [{"vertices": [1]}], "settings": {
+  const Scene s = read_scene(write("s.json", R"({"handles": [{"vertices": [1]}], "influence": 0.3,
+      "settings": {
       "modes": 30, "energy": "linear", "ks": 0.5, "kb": 2, "constraint_weight": 1e3,
       "constraints": "hard", "detail": "frames", "solver": "spatial", "unconstrained": "error",
       "iterations": 7, "clusters": 12, "arap_bending": 0.25, "arap_tolerance": 1e-6,
@@ -185,6 +189,7 @@ TEST_F(SceneFiles, AllSettingsReadAndWritten) {
   other.unconstrained = UnconstrainedPieces::Keep;
   const Scene back = read_scene(write("b.json", encode_scene(s)), V, other);
   EXPECT_EQ(back.modes, 30);
+  EXPECT_EQ(back.influence, 0.3);
   EXPECT_EQ(back.options.energy, DeformEnergy::Linear);
   EXPECT_EQ(back.options.unconstrained, UnconstrainedPieces::Error);
   EXPECT_EQ(back.options.arap.max_iterations, 7);

@@ -18,6 +18,8 @@
 //                           "center": [x, y, z] | "centroid" } } ],   (default: centroid)
 //        "fixed": [4, 5] | { "selection": "x.sel" }   (status 0 of a .sel)
 //                 | { "lowest": f, "axis": "y" },     (fraction f lowest, handles excepted)
+//        "influence": r,   (optional: the vertices farther than r bounding-box diagonals from the
+//                           handles, along the surface, are fixed too; influence.h)
 //        "settings": { "modes": 100, "energy": "arap", "ks": 0, "kb": 1,
 //                      "constraint_weight": 1e5, "constraints": "soft", "detail": "transfer",
 //                      "solver": "spectral", "unconstrained": "keep", "iterations": 100,
@@ -53,6 +55,7 @@ struct Scene {
   std::vector<Eigen::Affine3d> transforms;
   std::optional<int> modes;  // settings the scene asks for
   DeformOptions options;
+  std::optional<double> influence;  // of the bounding-box diagonal (scene_selection)
 };
 
 // .sel: one handle group (status 2) and the fixed set (status 0).
@@ -114,5 +117,11 @@ Scene benchmark_scene(const TriangleMesh& mesh);
 Selection to_mesh_numbering(const Selection& selection, const MeshReadInfo& info,
                             std::vector<std::string>* notes = nullptr,
                             std::string_view name = "selection");
+
+// The scene's selection on the loaded mesh: to_mesh_numbering(), then, when the scene has an
+// influence radius, limit_influence() with that fraction of the mesh's bounding-box diagonal.
+Selection scene_selection(const Scene& scene, const LoadedMesh& mesh,
+                          std::vector<std::string>* notes = nullptr,
+                          std::string_view name = "selection");
 
 }  // namespace specdeform
