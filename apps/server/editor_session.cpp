@@ -13,6 +13,7 @@
 #include "basis_store.h"
 #include "pose.h"
 #include "preview.h"
+#include "specdeform/deform/influence.h"
 #include "specdeform/deform/scene.h"
 #include "specdeform/mesh/generate.h"
 #include "specdeform/spectral/basis_cache.h"
@@ -121,8 +122,14 @@ struct EditorSession::State {
   // frame skips the detail reconstruction; the preview adds them back as displacements.
   std::optional<SpectralDeformer> sketch;
   double selection_seconds = 0.0, pin_error = 0.0;
+  double influence = 0.0;  // the region of influence, of the diagonal (0: none)
 
   const Vertices& rest() const { return poses[pose].rest; }
+  // What the deformers solve for the edit's selection: the surface beyond the region of
+  // influence fixed too.
+  Selection solved(const Selection& edit) const {
+    return influence > 0.0 ? limit_influence(rest_mesh(pose), edit, influence * diagonal) : edit;
+  }
   TriangleMesh rest_mesh(int p) const { return {poses[p].rest, loaded.mesh.F}; }
   const PreparedBasis& basis() const { return bases[pose]; }
 };
@@ -291,6 +298,7 @@ void EditorSession::text_message(std::string_view message) {
     scene.mesh = s.name;
     scene.modes = s.modes;
     scene.options = s.options;
+    if (s.influence > 0.0) scene.influence = s.influence;
     const std::vector<int>& to_file = s.loaded.info.vertex_to_file;
     const Selection& selection = s.edit.selection;
     for (size_t g = 0; g < selection.handles.size(); ++g) {
@@ -328,6 +336,8 @@ void EditorSession::change_settings(std::string_view message) {
   int modes = s.modes;
   bool base_view = s.base_view;
   if (auto v = number("modes", 1, 5000)) modes = static_cast<int>(*v);
+  double influence = s.influence;
+  if (auto v = number("influence", 0, 10)) influence = *v;
   if (auto v = number("ks", 0, 1e6)) o.ks = *v;
   if (auto v = number("kb", 0, 1e6)) o.kb = *v;
   if (auto v = word("energy")) o.energy = deform_energy_from_name(*v);
@@ -347,6 +357,8 @@ void EditorSession::change_settings(std::string_view message) {
     throw InputError("settings: m must be below the vertex count (" +
                      std::to_string(s.loaded.mesh.num_vertices()) + ")");
   }
+  const bool new_influence = influence != s.influence;
+  s.influence = influence;
   const bool new_basis = modes != s.modes;
   const bool new_deformer = new_basis || o.energy != s.options.energy || o.ks != s.options.ks ||
                             o.kb != s.options.kb || o.detail != s.options.detail ||
@@ -355,7 +367,7 @@ void EditorSession::change_settings(std::string_view message) {
   if (new_deformer) {
     const PreparedBasis basis = new_basis ? compute_basis(s.rest_mesh(s.pose), modes) : s.basis();
     SpectralDeformer deformer(s.rest_mesh(s.pose), basis.harmonics, o);
-    if (s.has_handles) deformer.set_selection(s.edit.selection);
+    if (s.has_handles) deformer.set_selection(s.solved(s.edit.selection));
     s.deformer.emplace(std::move(deformer));
     if (new_basis) {  // the other poses' bases have the old m
       for (PreparedBasis& b : s.bases) b.harmonics.reset();
@@ -365,6 +377,9 @@ void EditorSession::change_settings(std::string_view message) {
     s.options = o;
     config_.modes = modes;  // meshes opened later start with these settings too
     config_.options = o;
+    sync_sketch();
+  } else if (new_influence && s.has_handles) {
+    s.deformer->set_selection(s.solved(s.edit.selection));
     sync_sketch();
   }
   s.base_view = base_view;
@@ -393,12 +408,12 @@ void EditorSession::set_edit(GroupSelection edit, bool record, bool echo) {
   const Clock::time_point start = Clock::now();
   if (handle_vertices > 0) {
     try {
-      s.deformer->set_selection(edit.selection);
+      s.deformer->set_selection(s.solved(edit.selection));
     } catch (...) {
-      if (s.has_handles) s.deformer->set_selection(s.edit.selection);
+      if (s.has_handles) s.deformer->set_selection(s.solved(s.edit.selection));
       throw;
     }
-    if (s.sketch) s.sketch->set_selection(edit.selection);
+    if (s.sketch) s.sketch->set_selection(s.solved(edit.selection));
   }
   s.selection_seconds = seconds_since(start);
   s.pin_error = pin_error;
@@ -614,6 +629,7 @@ void EditorSession::send_ready() {
                            {"detail", name(s.options.detail)},
                            {"constraints", name(s.options.constraints)},
                            {"unconstrained", name(s.options.unconstrained)},
+                           {"influence", s.influence},
                            {"view", s.base_view ? "base" : "detailed"}}},
                          {"basis",
                           {{"seconds", b.seconds},
@@ -661,7 +677,7 @@ void EditorSession::sync_sketch() {
   DeformOptions o = s.options;
   o.detail = DetailMethod::None;
   s.sketch.emplace(s.rest_mesh(s.pose), s.basis().harmonics, o);
-  if (s.has_handles) s.sketch->set_selection(s.edit.selection);
+  if (s.has_handles) s.sketch->set_selection(s.solved(s.edit.selection));
 }
 
 const Vertices& EditorSession::result() {

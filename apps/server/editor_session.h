@@ -8,7 +8,8 @@
 //     {"type": "hello"}              everything again (a new connection)
 //     {"type": "settings", "modes": m, "energy": "linear|arap", "ks": x, "kb": x,
 //      "detail": "none|displacement|frames|transfer", "constraints": "soft|hard",
-//      "unconstrained": "follow|keep|error", "view": "detailed|base"}
+//      "unconstrained": "follow|keep|error", "influence": r (of the diagonal, 0: none),
+//      "view": "detailed|base"}
 //                                    any subset; answered with "ready" (also when rejected)
 //     {"type": "open_demo"}          the built-in bumpy bar
 //     {"type": "commit"}             the transforms as they are now become an undo step

@@ -12,6 +12,7 @@
 #include "pose.h"
 #include "preview.h"
 #include "protocol.h"
+#include "specdeform/deform/influence.h"
 #include "specdeform/deform/scene.h"
 #include "specdeform/mesh/generate.h"
 
@@ -224,6 +225,27 @@ TEST_F(EditorSessionTest, EverySettingsRequestEndsInReady) {
   }
   EXPECT_EQ(last_text("ready")["settings"]["kb"], 2.0);
   EXPECT_EQ(last_text("ready")["settings"]["unconstrained"], "keep");
+}
+
+// A region of influence: the surface farther from the handle than the radius stays in place (to
+// the frame's float precision); the setting is reported, and the selection itself is unchanged.
+TEST_F(EditorSessionTest, TheRegionOfInfluenceHoldsTheSurfaceBeyondIt) {
+  select(plain(selection_));
+  session_->handle(false, R"({"type": "settings", "influence": 0.25})");
+  EXPECT_EQ(last_text("ready")["settings"]["influence"], 0.25);
+  session_->handle(true, frame(Eigen::Affine3d(Eigen::Translation3d(0.3, 0, 0.2))));
+  const Vertices V = last_frame();
+  const Eigen::VectorXd d = handle_distances({rest_, make_icosphere(2).F}, selection_);
+  const double radius = 0.25 * bounding_box_diagonal(rest_);
+  int held = 0;
+  for (int i = 0; i < rest_.rows(); ++i) {
+    if (d[i] <= radius) continue;
+    EXPECT_LT((V.row(i) - rest_.row(i)).norm(), 1e-5) << i;
+    ++held;
+  }
+  EXPECT_GT(held, 20);
+  EXPECT_GT((V.row(selection_.handles[0][0]) - rest_.row(selection_.handles[0][0])).norm(), 0.2);
+  EXPECT_EQ(last_text("state")["fixed"], selection_.fixed.size());
 }
 
 TEST_F(EditorSessionTest, SettingsRebuildAndKeepTheSelection) {

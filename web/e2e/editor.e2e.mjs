@@ -549,6 +549,51 @@ try {
     await page.evaluate(() => document.activeElement?.blur());
     await keys('1');
 
+    log('region of influence');
+    await reset();
+    const detail = await page.inputValue('#detail');
+    await page.selectOption('#detail', 'transfer'); // anchors the held vertices exactly
+    await waitReady(60000);
+    await page.fill('#influence', '30');
+    await page.press('#influence', 'Enter');
+    await waitReady(60000);
+    await page.keyboard.press('4');
+    await keys('g', 'z', ...String(step), 'Enter');
+    r = await result();
+    check(followed(r) < 1e-2, `the handle followed G Z with a region of influence (${followed(r)})`);
+    {
+      // Beyond the radius in space is beyond it along the surface: those free vertices stay.
+      const radius = 0.3 * r.diagonal;
+      const handle = [];
+      r.labels.forEach((l, v) => l >= 2 && handle.push(v));
+      let held = 0, worst = 0, fixed = 0;
+      const moved = (v) => Math.hypot(...[0, 1, 2].map((k) => r.now[3 * v + k] - r.rest[3 * v + k]));
+      r.labels.forEach((l, v) => {
+        if (l === 1) fixed = Math.max(fixed, moved(v));
+        if (l !== 0) return;
+        const near = handle.some((h) => Math.hypot(...[0, 1, 2].map((k) => r.rest[3 * v + k] - r.rest[3 * h + k])) <= radius);
+        if (near) return;
+        ++held;
+        worst = Math.max(worst, moved(v));
+      });
+      log(`held ${held}: ${worst / r.diagonal}, fixed ${fixed / r.diagonal} of the diagonal`);
+      check(held > 100 && worst <= fixed + 1e-5 * r.diagonal,
+        `the surface beyond the radius stays as the fixed vertices do (${held} vertices, ${worst / r.diagonal} of the diagonal; fixed ${fixed / r.diagonal})`);
+    }
+    // The wheel during a move widens the region instead of zooming.
+    await keys('g', 'z');
+    await page.mouse.move(canvas.x, canvas.y);
+    await page.mouse.wheel(0, -100);
+    await waitReady(60000);
+    check(Number(await page.inputValue('#influence')) > 30, `the wheel widened the region (${await page.inputValue('#influence')}%)`);
+    await keys('Escape');
+    await page.fill('#influence', '0');
+    await page.press('#influence', 'Enter');
+    await waitReady(60000);
+    await page.selectOption('#detail', detail);
+    await waitReady(60000);
+    await reset();
+
     log('views');
     const looking = () => api(() => {
       const [p, q] = [window.specdeformEditor.cameraPosition(), window.specdeformEditor.cameraTarget()];

@@ -42,13 +42,16 @@ export class Brush {
     return Uint32Array.from(out);
   }
 
-  geodesic(positions: Float32Array, start: number, radius: number): Uint32Array {
+  // The vertices within `radius` of the nearest of `starts`, along the edges.
+  geodesic(positions: Float32Array, starts: ArrayLike<number>, radius: number): Uint32Array {
     const { distance, settled, offsets, neighbours } = this;
     const heap = new Heap();
-    const touched: number[] = [start];
+    const touched: number[] = Array.from(starts);
     const done: number[] = [];
-    distance[start] = 0;
-    heap.push(0, start);
+    for (const start of touched) {
+      distance[start] = 0;
+      heap.push(0, start);
+    }
     while (heap.size > 0) {
       const d = heap.topKey();
       const v = heap.pop();

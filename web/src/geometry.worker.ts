@@ -55,7 +55,7 @@ self.onmessage = (e: MessageEvent<WorkerRequest>) => {
     if (!mesh?.brush) return;
     const [x, y, z] = m.center;
     const vertices = m.geodesic
-      ? mesh.brush.geodesic(mesh.positions, m.vertex, m.radius)
+      ? mesh.brush.geodesic(mesh.positions, [m.vertex], m.radius)
       : mesh.brush.euclidean(mesh.positions, x, y, z, m.radius);
     post({ kind: 'brush', id: m.id, vertices }, [vertices.buffer]);
   }

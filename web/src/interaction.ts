@@ -39,7 +39,6 @@ export class Interaction {
   private cursorPress: { x: number; y: number } | null = null; // a Shift + right press
   pivotMode: PivotMode = 'median';
   cursor: THREE.Vector3 | null = null; // the 3D cursor
-  private topology: { indices: Uint32Array; brush: Brush } | null = null;
   readonly xMirror = new XMirror();
   // B arms a box (drawn with the left button); Ctrl + right-drag draws a lasso.
   private region: { armed: boolean; lasso: boolean; path: Point[] } = { armed: false, lasso: false, path: [] };
@@ -54,11 +53,24 @@ export class Interaction {
     view.addEventListener('pointerup', (e) => this.up(e));
     view.addEventListener('pointercancel', (e) => this.up(e));
     view.addEventListener('pointerleave', () => v.showBrush(null, 0));
+    // The wheel during a drag or a modal transform changes the region of influence (when there
+    // is one) instead of zooming, as Blender's proportional editing radius.
+    view.addEventListener('wheel', (e) => this.wheel(e), { capture: true, passive: false });
     v.gizmo.addEventListener('dragging-changed', (e) => {
       if (e.value) this.beginGizmo();
       else this.endDrag(true);
     });
     v.gizmo.addEventListener('objectChange', () => this.gizmoMoved());
+  }
+
+  private wheel(e: WheelEvent): void {
+    const influence = this.s.ready?.settings.influence ?? 0;
+    if (!this.drag || !(influence > 0)) return;
+    e.preventDefault();
+    e.stopImmediatePropagation();
+    const next = Math.min(10, Math.max(0.005, influence * (e.deltaY < 0 ? 1.15 : 1 / 1.15)));
+    this.s.request({ type: 'settings', influence: next }, 'settings', 'ready');
+    this.showHeader(`region of influence: ${(100 * next).toFixed(1)}% of the diagonal`);
   }
 
   get radius(): number {
@@ -476,10 +488,7 @@ export class Interaction {
   // ------------------------------------------------------------ selection by topology
 
   private get graph(): Brush {
-    if (this.topology?.indices !== this.s.indices) {
-      this.topology = { indices: this.s.indices, brush: new Brush(this.s.labels.length, this.s.indices) };
-    }
-    return this.topology.brush;
+    return this.s.graph();
   }
 
   // The Linked button: the next left click selects the piece under it (L does it at once).

@@ -85,6 +85,10 @@ export class Panel {
       s.request({ type: 'settings', view: (e.target as HTMLInputElement).checked ? 'base' : 'detailed' }, 'view', 'ready'));
     // Fields: Enter applies and leaves the field (so that shortcuts work again), Escape puts the
     // server's value back. m is applied with its button: a new basis costs seconds.
+    $('influence').addEventListener('change', (e) => {
+      const v = Number((e.target as HTMLInputElement).value);
+      if (Number.isFinite(v) && v >= 0) s.request({ type: 'settings', influence: v / 100 }, 'settings', 'ready');
+    });
     for (const id of ['ks', 'kb']) {
       $(id).addEventListener('change', (e) => {
         const v = Number((e.target as HTMLInputElement).value);
@@ -293,7 +297,7 @@ export class Panel {
       : phase.kind === 'empty' ? 'no mesh open' : phase.kind === 'loading' ? 'preparing the mesh…' : 'connecting…';
     const enable = (id: string, on: boolean) => ($<HTMLButtonElement>(id).disabled = !on);
     for (const id of ['undo', 'redo', 'reset', 'apply-pose', 'export-mesh', 'export-scene', 'clear', 'new-group',
-      'energy', 'ks', 'kb', 'detail', 'constraints', 'unconstrained', 'modes', 'show-base', 'group', 'export-format', 'gizmo-translate',
+      'energy', 'ks', 'kb', 'detail', 'constraints', 'unconstrained', 'influence', 'modes', 'show-base', 'group', 'export-format', 'gizmo-translate',
       'gizmo-rotate', 'gizmo-scale', 'pivot', 'select-linked', 'select-invert', 'select-grow', 'select-shrink', 'select-box', 'xray']) {
       enable(id, editable);
     }
@@ -341,7 +345,7 @@ export class Panel {
     const r = this.s.ready;
     if (!r) {
       // Nothing known yet: placeholders, not a default that looks like a setting.
-      for (const id of ['modes', 'energy', 'ks', 'kb', 'detail', 'constraints', 'unconstrained']) $<HTMLInputElement>(id).value = '';
+      for (const id of ['modes', 'energy', 'ks', 'kb', 'detail', 'constraints', 'unconstrained', 'influence']) $<HTMLInputElement>(id).value = '';
       $<HTMLInputElement>('show-base').checked = false;
       return this.renderModes();
     }
@@ -352,6 +356,7 @@ export class Panel {
     $<HTMLSelectElement>('detail').value = r.settings.detail;
     $<HTMLSelectElement>('constraints').value = r.settings.constraints;
     $<HTMLSelectElement>('unconstrained').value = r.settings.unconstrained;
+    $<HTMLInputElement>('influence').value = String(+(100 * r.settings.influence).toFixed(2));
     $<HTMLInputElement>('show-base').checked = r.settings.view === 'base';
     this.renderModes();
   }

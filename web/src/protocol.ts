@@ -33,6 +33,7 @@ export interface Settings {
   detail: Detail;
   constraints: Constraints;
   unconstrained: Unconstrained; // pieces without a handle or fixed vertex
+  influence: number; // the region of influence around the handles, of the diagonal (0: none)
   view: View;
 }
 

@@ -2,6 +2,7 @@
 // the handle groups' transforms, and one explicit phase. Server messages come in here and
 // nowhere else; what the page shows follows from this state (panel.ts) and the view.
 import * as THREE from 'three';
+import { Brush } from './brush';
 import { Connection, ConnectionStatus } from './connection';
 import type { Slot, WorkerReply, WorkerRequest } from './geometry.worker';
 import type { Measures } from './measures';
@@ -381,6 +382,7 @@ export class EditorState {
       this.restoreSettings = { type: 'settings', modes: previous.modes, ...previous.settings };
     }
     this.ready = m;
+    if (previous?.settings.influence !== m.settings.influence) this.paint();
     if (m.basis.warning) this.note(m.basis.warning, 'error');
     if (newMesh) requestAnimationFrame(() => this.choosePreview());
   }
@@ -453,13 +455,37 @@ export class EditorState {
     }
   }
 
-  // Colours from labels, for all vertices or the ones listed.
+  // The mesh's edge graph, for selections by topology and the region of influence.
+  graph(): Brush {
+    if (this.topology?.indices !== this.indices) {
+      this.topology = { indices: this.indices, brush: new Brush(this.labels.length, this.indices) };
+    }
+    return this.topology.brush;
+  }
+  private topology: { indices: Uint32Array; brush: Brush } | null = null;
+
+  // Free vertices that the region of influence holds (the server's rule, for drawing): beyond
+  // its radius from every handle vertex, along the edges; null when there is no region.
+  private heldByInfluence(): Uint8Array | null {
+    const radius = (this.ready?.settings.influence ?? 0) * (this.ready?.diagonal ?? 1);
+    const handles: number[] = [];
+    this.labels.forEach((l, v) => l >= 2 && handles.push(v));
+    if (!(radius > 0) || handles.length === 0) return null;
+    const held = new Uint8Array(this.labels.length).fill(1);
+    for (const v of this.graph().geodesic(this.rest, handles, radius)) held[v] = 0;
+    return held;
+  }
+
+  // Colours from labels, for all vertices or the ones listed (all when a region of influence is
+  // drawn: a stroke moves its border).
   paint(vertices?: ArrayLike<number>): void {
     const n = this.labels.length;
     const colors = this.colorBuffer.length === 3 * n ? this.colorBuffer : (this.colorBuffer = new Float32Array(3 * n));
+    const held = this.heldByInfluence();
+    if (held) vertices = undefined;
     const set = (v: number) => {
       const l = this.labels[v];
-      const c = l === FREE ? FREE_COLOR : l === FIXED ? FIXED_COLOR
+      const c = l === FREE ? (held?.[v] ? HELD_COLOR : FREE_COLOR) : l === FIXED ? FIXED_COLOR
         : this.groups[l - 2]?.pinned ? PIN_COLOR : GROUP_COLORS[(l - 2) % GROUP_COLORS.length];
       colors[3 * v] = c.r;
       colors[3 * v + 1] = c.g;
@@ -480,6 +506,7 @@ export const GROUP_HEX = [0xf28e2b, 0x59a14f, 0xb07aa1, 0x76b7b2, 0xedc948, 0xe1
 const GROUP_COLORS = GROUP_HEX.map((c) => new THREE.Color(c));
 const FREE_COLOR = new THREE.Color(0xc9ccd3);
 const FIXED_COLOR = new THREE.Color(0x4e79a7);
+const HELD_COLOR = new THREE.Color(0xa9b8cc); // held by the region of influence
 export const PIN_HEX = 0x1f3b63;
 const PIN_COLOR = new THREE.Color(PIN_HEX);
 
