@@ -70,7 +70,9 @@ export class Interaction {
     e.stopImmediatePropagation();
     const next = Math.min(10, Math.max(0.005, influence * (e.deltaY < 0 ? 1.15 : 1 / 1.15)));
     this.s.request({ type: 'settings', influence: next }, 'settings', 'ready');
-    this.showHeader(`region of influence: ${(100 * next).toFixed(1)}% of the diagonal`);
+    const region = `region of influence ${(100 * next).toFixed(1)}% of the diagonal`;
+    const modal = this.drag.modal;
+    this.showHeader(modal ? `${modal.readout(this.pointer)} · ${region}` : region);
   }
 
   get radius(): number {

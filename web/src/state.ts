@@ -463,6 +463,7 @@ export class EditorState {
     return this.topology.brush;
   }
   private topology: { indices: Uint32Array; brush: Brush } | null = null;
+  influenceHeld = 0; // free vertices the region of influence holds (as drawn)
 
   // Free vertices that the region of influence holds (the server's rule, for drawing): beyond
   // its radius from every handle vertex, along the edges; null when there is no region.
@@ -470,9 +471,11 @@ export class EditorState {
     const radius = (this.ready?.settings.influence ?? 0) * (this.ready?.diagonal ?? 1);
     const handles: number[] = [];
     this.labels.forEach((l, v) => l >= 2 && handles.push(v));
+    this.influenceHeld = 0;
     if (!(radius > 0) || handles.length === 0) return null;
     const held = new Uint8Array(this.labels.length).fill(1);
     for (const v of this.graph().geodesic(this.rest, handles, radius)) held[v] = 0;
+    this.labels.forEach((l, v) => l === FREE && held[v] && ++this.influenceHeld);
     return held;
   }
 
@@ -506,7 +509,7 @@ export const GROUP_HEX = [0xf28e2b, 0x59a14f, 0xb07aa1, 0x76b7b2, 0xedc948, 0xe1
 const GROUP_COLORS = GROUP_HEX.map((c) => new THREE.Color(c));
 const FREE_COLOR = new THREE.Color(0xc9ccd3);
 const FIXED_COLOR = new THREE.Color(0x4e79a7);
-const HELD_COLOR = new THREE.Color(0xa9b8cc); // held by the region of influence
+const HELD_COLOR = new THREE.Color(0x9a9aa3); // held by the region of influence: grey, darker than free
 export const PIN_HEX = 0x1f3b63;
 const PIN_COLOR = new THREE.Color(PIN_HEX);
 
