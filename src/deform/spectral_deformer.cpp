@@ -68,8 +68,9 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
   components_ = vertex_components(mesh_, &num_components_);
   piece_modes_.assign(num_components_, 0);
   if (has_basis) {
-    for (Eigen::Index j = 0; j < basis_->basis.cols();
-         ++j) {  // a mode's piece: its largest entry's
+    // A mode's piece: the piece of its largest entry (a basis of several pieces is computed
+    // piece by piece, each mode on one).
+    for (Eigen::Index j = 0; j < basis_->basis.cols(); ++j) {
       Eigen::Index i;
       basis_->basis.col(j).cwiseAbs().maxCoeff(&i);
       ++piece_modes_[components_[i]];
