@@ -116,6 +116,9 @@ echo "== Assemblies: folds at a turning handle, and a free piece that follows"
 build/bin/handle_folds >"$out/handle_folds.md"
 PYTHONPATH=build/python /usr/bin/python3 scripts/assembly_pictures.py "$work/assembly" "$out/pictures"
 node web/e2e/render.mjs "$work/assembly/jobs.json"
+PYTHONPATH=build/python /usr/bin/python3 scripts/handle_border_pictures.py "$models/camelhead.off" \
+  "$work/handle_border" "$out/pictures"
+node web/e2e/render.mjs "$work/handle_border/jobs.json"
 
 echo "== pictures"
 jobs="["

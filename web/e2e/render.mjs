@@ -2,9 +2,12 @@
 //
 //   node e2e/render.mjs JOBS.json
 //
-// JOBS.json: [{"mesh": "a.obj", "png": "a.png", "view": [x, y, z], "zoom": 1.3}, ...]: each
-// mesh is opened in the editor (`specdeform edit`) through its file input, looked at from the
-// direction `view` (towards the mesh's centre), and the view is saved without the side panel.
+// JOBS.json: [{"mesh": "a.obj", "png": "a.png", "view": [x, y, z], "zoom": 1.3,
+// "target": [x, y, z]}, ...]: each mesh is opened in the editor (`specdeform edit`) through its
+// file input, looked at from the direction `view` (towards `target`, by default the mesh's
+// centre), and the view is saved without the side panel. The editor keeps its camera for a mesh
+// of the same triangles: such jobs share the first one's view, except close-ups (with a target),
+// which start from the whole mesh framed.
 import { readFileSync } from 'node:fs';
 import { basename, dirname, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -38,7 +41,10 @@ try {
     );
     const { error } = await outcome.jsonValue();
     if (error) throw new Error(`${job.mesh}: ${error}`);
-    await page.evaluate(([v, z]) => window.specdeformEditor.setView(v, z), [job.view ?? [0.25, 0.35, 1], job.zoom ?? 1]);
+    // A close-up (a target) starts from the whole mesh framed (Home), not from the last view.
+    if (job.target) await page.keyboard.press('Home');
+    await page.evaluate(([v, z, t]) => window.specdeformEditor.setView(v, z, t ?? undefined),
+      [job.view ?? [0.25, 0.35, 1], job.zoom ?? 1, job.target ?? null]);
     await page.waitForTimeout(300);
     await page.locator('#view').screenshot({ path: job.png });
     console.log(`rendered ${job.png}`);

@@ -38,9 +38,10 @@ const viewer = state.viewer;
   measures: () => state.measures,
   cursor: () => interaction.cursor?.toArray() ?? null,
   gizmoOnScreen: () => (viewer.gizmo.object ? viewer.toScreen(viewer.pivot.position) : null),
-  setView: (direction: [number, number, number], zoom = 1) => {
+  setView: (direction: [number, number, number], zoom = 1, at?: [number, number, number]) => {
     const target = viewer.orbit.target;
     const distance = viewer.camera.position.distanceTo(target) / zoom;
+    if (at) target.set(...at);
     viewer.camera.position.copy(target).add(new THREE.Vector3(...direction).normalize().multiplyScalar(distance));
     viewer.orbit.update();
     viewer.requestRender();
