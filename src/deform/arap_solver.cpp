@@ -6,12 +6,11 @@
 #include <vector>
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
-#include <Eigen/SVD>
 
 #include "deform/reduced_forms.h"
 #include "linalg/basis_product.h"
+#include "linalg/nearest_rotation.h"
 #include "membrane_stiffness.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/vertex_clusters.h"
@@ -25,35 +24,10 @@ namespace {
 
 using Sparse = Eigen::SparseMatrix<double>;
 
-// The rotation R maximising tr(R X) over all rotations (reflections excluded): the polar factor
-// of Z = X^T with the reflection removed, R = U diag(1, 1, det(U V^T)) V^T for Z = U S V^T. V and
-// S^2 come from the closed-form eigen-decomposition of Z^T Z, u_i = Z v_i / s_i for the two
-// largest s_i, u_3 = u_1 x u_2 and v_3 = v_1 x v_2 (no division by the smallest singular value,
-// and the right orientation by construction): 2-3 times faster than a Jacobi SVD, as accurate.
-// Where Z has rank below 2 the Jacobi SVD decides.
+// The rotation R maximising tr(R X) over all rotations (reflections excluded): the one nearest
+// to X^T.
 void fit_rotation(const Eigen::Matrix3d& X, Eigen::Ref<Eigen::Matrix3d> R) {
-  const Eigen::Matrix3d Z = X.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
-  eigen.computeDirect(X * Z);  // Z^T Z, ascending eigenvalues
-  const Eigen::Vector3d v1 = eigen.eigenvectors().col(2);
-  const Eigen::Vector3d v2 =
-      (eigen.eigenvectors().col(1) - v1.dot(eigen.eigenvectors().col(1)) * v1).normalized();
-  const Eigen::Vector3d u1 = (Z * v1).normalized();
-  Eigen::Vector3d u2 = Z * v2;
-  u2 -= u1.dot(u2) * u1;
-  const double scale = Z.norm();
-  if (u2.norm() > 1e-9 * scale && std::isfinite(u2.norm())) {
-    u2.normalize();
-    Eigen::Matrix3d U, V;
-    U << u1, u2, u1.cross(u2);
-    V << v1, v2, v1.cross(v2);
-    R = U * V.transpose();
-    return;
-  }
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(Z, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d U = svd.matrixU();
-  if ((U * svd.matrixV().transpose()).determinant() < 0) U.col(2) = -U.col(2);
-  R = U * svd.matrixV().transpose();
+  R = detail::nearest_rotation(X.transpose());
 }
 
 // The local step: each R_k maximises tr(R_k S_k) given the covariances S (3k x 3, blocks S_k),
@@ -311,10 +285,7 @@ double energy_scale(const Eigen::MatrixX3d& rest) {
 
 // The rotation vector (axis times angle) of the rotation nearest to `linear` (its polar part).
 Eigen::Vector3d rotation_vector(const Eigen::Matrix3d& linear) {
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(linear, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d U = svd.matrixU();
-  if ((U * svd.matrixV().transpose()).determinant() < 0) U.col(2) = -U.col(2);
-  const Eigen::AngleAxisd rotation(Eigen::Matrix3d(U * svd.matrixV().transpose()));
+  const Eigen::AngleAxisd rotation(detail::nearest_rotation(linear));
   return rotation.angle() * rotation.axis();
 }
 

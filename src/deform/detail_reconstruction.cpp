@@ -6,9 +6,9 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
-#include <Eigen/SVD>
 
 #include "anchored_poisson.h"
+#include "linalg/nearest_rotation.h"
 #include "linalg/parallel.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/operators/cotan_laplacian.h"
@@ -36,10 +36,7 @@ Eigen::Matrix3d ring_rotation(const Vertices& rest, const Vertices& deformed,
   }
   length /= std::max(size, 1);
   A += length * length * normals.row(i).transpose() * rest_normals.row(i);
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d U = svd.matrixU();
-  if ((U * svd.matrixV().transpose()).determinant() < 0.0) U.col(2) *= -1.0;
-  return U * svd.matrixV().transpose();
+  return detail::nearest_rotation(A);
 }
 
 // [c - a, b - a, n] of triangle f, n the unit normal (zero for a degenerate triangle).

@@ -2,8 +2,7 @@
 
 #include <algorithm>
 
-#include <Eigen/SVD>
-
+#include "linalg/nearest_rotation.h"
 #include "mesh/triangle_tree.h"
 #include "specdeform/exceptions.h"
 
@@ -18,14 +17,6 @@ Eigen::Vector3d barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
   E << b - a, c - a;
   const Eigen::Vector2d uv = (E.transpose() * E).ldlt().solve(E.transpose() * (p - a));
   return {1.0 - uv.sum(), uv[0], uv[1]};
-}
-
-// The rotation nearest to A (Frobenius norm).
-Eigen::Matrix3d nearest_rotation(const Eigen::Matrix3d& A) {
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d U = svd.matrixU();
-  if ((U * svd.matrixV().transpose()).determinant() < 0.0) U.col(2) *= -1.0;
-  return U * svd.matrixV().transpose();
 }
 
 // The triangle's edge frame: its two edges and its normal, scaled like an edge.
