@@ -9,9 +9,11 @@
 // of vertex V as the handle and the lowest 10% along y fixed. No basis cache; the eigensolver
 // is the editor's default for the mesh's size unless named. Printed as one JSON object: the
 // time to open the file (read it, compute the basis, build the deformer), the selection's
-// server time, the first frame's latency, a paint stroke's time (the selection again with the
-// fixed region grown by the vertices of one more handle-sized patch, until its state comes
-// back), and two runs:
+// server time, the first frame's latency, the first drag's result from opening, the time
+// until the transfer's background factorisation is ready (its "detail" state; the drags below
+// wait for it), a paint stroke's time (the selection again with the fixed region grown by the
+// vertices of one more handle-sized patch, until its state comes back; then until its transfer
+// is ready), and two runs:
 //  - "mouse": frames sent at H per second (default 60, a mouse) for S seconds (default 4): the
 //    results per second that come back and the latency of each (median, 90th percentile);
 //  - "closed_loop": the next frame sent as soon as the previous result arrives: the most
@@ -102,23 +104,33 @@ net::awaitable<void> run_client(uint16_t port, sd::Selection selection, std::vec
   groups.transforms.assign(selection.handles.size(), Eigen::Affine3d::Identity());
   groups.pinned.assign(selection.handles.size(), false);
   const std::string message = sd::server::encode_selection(groups, sd::server::Tag::Selection);
-  const auto states = [&](int count) -> net::awaitable<void> {
-    while (count > 0) {
+  // Reads up to the count-th "state" answering `request` ("detail": the transfer's background
+  // factorisation is ready); returns it.
+  const auto states = [&](int count, std::string_view request) -> net::awaitable<nlohmann::json> {
+    for (;;) {
       beast::flat_buffer buffer;
       co_await ws.async_read(buffer, net::use_awaitable);
-      const std::string m = beast::buffers_to_string(buffer.data());
-      if (m.find("\"error\"") != std::string::npos) throw std::runtime_error(m);
-      if (!ws.got_binary() && m.find("\"state\"") != std::string::npos) --count;
+      if (ws.got_binary()) continue;
+      const nlohmann::json m = nlohmann::json::parse(beast::buffers_to_string(buffer.data()));
+      if (m["type"] == "error") throw std::runtime_error(m.dump());
+      if (m["type"] == "state" && (request.empty() || m["request"] == request) && --count == 0) {
+        co_return m;
+      }
     }
   };
   const Clock::time_point selecting = Clock::now();
   co_await ws.async_write(net::buffer(message), net::use_awaitable);
-  co_await states(2);  // the connection's state (a hello), the selection's
+  co_await states(1, "hello");
+  const bool pending = (co_await states(1, "selection"))["detail_pending"];
   out["selection_seconds"] = ms(Clock::now() - selecting) / 1e3;
   const Clock::time_point first = Clock::now();
   co_await ws.async_write(net::buffer(drag.frame(1)), net::use_awaitable);
   co_await next_result(ws);
   out["first_frame_ms"] = ms(Clock::now() - first);
+  out["first_drag_seconds"] =
+      out["open_seconds"].get<double>() + ms(Clock::now() - selecting) / 1e3;
+  if (pending) co_await states(1, "detail");  // the drags below with the transfer's details
+  out["transfer_ready_seconds"] = ms(Clock::now() - selecting) / 1e3;
 
   // A mouse: frames at a fixed rate, results read as they come.
   std::map<uint32_t, Clock::time_point> sent;
@@ -175,9 +187,11 @@ net::awaitable<void> run_client(uint16_t port, sd::Selection selection, std::vec
   co_await ws.async_write(
       net::buffer(sd::server::encode_selection(groups, sd::server::Tag::Selection)),
       net::use_awaitable);
-  co_await states(1);
+  const bool stroke_pending = (co_await states(1, "selection"))["detail_pending"];
   out["stroke_seconds"] = ms(Clock::now() - stroking) / 1e3;
   out["stroke_vertices"] = stroke.size();
+  if (stroke_pending) co_await states(1, "detail");
+  out["stroke_transfer_seconds"] = ms(Clock::now() - stroking) / 1e3;
   co_await ws.async_close(websocket::close_code::normal, net::use_awaitable);
 }
 

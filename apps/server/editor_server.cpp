@@ -283,7 +283,8 @@ EditorServer::EditorServer(ServerConfig config, EditorConfig editor)
   s.assets = read_assets(s.config.assets);
   s.session = std::make_unique<EditorSession>(
       std::move(editor),
-      [this](bool binary, std::string data) { impl_->send(binary, std::move(data)); });
+      [this](bool binary, std::string data) { impl_->send(binary, std::move(data)); },
+      [this](std::function<void()> job) { impl_->mailbox.push(std::move(job), false); });
   boost::system::error_code ec;
   const net::ip::address address = net::ip::make_address(s.config.host, ec);
   if (ec) throw InputError("--host " + s.config.host + ": not an IP address");

@@ -141,8 +141,8 @@ LoadedMesh demo_mesh() {
   return demo;
 }
 
-EditorSession::EditorSession(EditorConfig config, Send send)
-    : config_(std::move(config)), send_(std::move(send)) {}
+EditorSession::EditorSession(EditorConfig config, Send send, Post post)
+    : config_(std::move(config)), send_(std::move(send)), post_(std::move(post)) {}
 
 EditorSession::~EditorSession() = default;
 
@@ -369,6 +369,7 @@ void EditorSession::change_settings(std::string_view message) {
     SpectralDeformer deformer(s.rest_mesh(s.pose), basis.harmonics, o);
     if (s.has_handles) deformer.set_selection(s.solved(s.edit.selection));
     s.deformer.emplace(std::move(deformer));
+    watch_detail();
     if (new_basis) {  // the other poses' bases have the old m
       for (PreparedBasis& b : s.bases) b.harmonics.reset();
       s.bases[s.pose] = basis;
@@ -451,6 +452,7 @@ void EditorSession::restore(size_t entry) {
     if (!basis.harmonics) basis = compute_basis(s.rest_mesh(e.pose), s.modes);
     SpectralDeformer deformer(s.rest_mesh(e.pose), basis.harmonics, s.options);
     s.deformer.emplace(std::move(deformer));
+    watch_detail();
     s.pose = e.pose;
     s.has_handles = false;
     s.result = s.rest();
@@ -494,6 +496,7 @@ void EditorSession::apply_pose() {
     edit.pinned.push_back(false);
   }
   s.deformer.emplace(std::move(deformer));
+  watch_detail();
   s.poses.push_back({posed.V, hex(mesh_hash(posed))});
   s.bases.push_back(std::move(basis));
   for (int p = 0; p + kPoseBases < static_cast<int>(s.bases.size()); ++p) {
@@ -599,6 +602,7 @@ void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
   s.diagonal = bounding_box_diagonal(s.rest());
   s.history.push_back({s.edit, 0});
   state_ = std::move(next);
+  watch_detail();
   send_mesh();
   send_ready();
   send_selection();
@@ -667,7 +671,22 @@ void EditorSession::send_state() {
                      {"free_pieces", s.has_handles ? s.deformer->free_pieces() : 0},
                      {"constrained_piece_modes",
                       s.has_handles ? s.deformer->constrained_piece_modes() : std::vector<int>()},
+                     {"detail_pending", s.has_handles && s.deformer->detail_pending()},
                      {"pose", s.pose}}));
+}
+
+void EditorSession::watch_detail() {
+  if (!post_) return;
+  state_->deformer->on_detail_ready([this] { post_([this] { detail_ready(); }); });
+}
+
+void EditorSession::detail_ready() {
+  if (!state_) return;
+  State& s = *state_;
+  if (!s.has_handles || s.deformer->detail_pending()) return;  // a newer selection factors
+  request_ = "detail";
+  if (s.deformer->applied_detail() != s.options.detail) solve_and_send();
+  send_state();
 }
 
 void EditorSession::sync_sketch() {

@@ -27,8 +27,10 @@
 //     {"type": "state", "request": the request's type ("open": the server's first mesh),
 //      "groups": [{"vertices", "pinned", "transform": 16 numbers}], "fixed",
 //      "undo", "redo", "selection_seconds", "pin_error", "free_pieces",
-//      "constrained_piece_modes", "pose"}
-//                                               after every edit, last (its frame comes first)
+//      "constrained_piece_modes", "detail_pending", "pose"}
+//                                               after every edit, last (its frame comes first);
+//                                               request "detail": the transfer's background
+//                                               factorisation became ready (its frame first)
 //     {"type": "empty", "request"}              no mesh is open (a failed or cancelled start)
 //     {"type": "error", "message": one line, "request": the request's type, "cancelled": b}
 // Every request is answered: by its reply (ready, state, file, preview, a frame), or by an
@@ -54,11 +56,14 @@
 namespace specdeform::server {
 
 // Solver settings of the editor: the library's, but frames with the basis in single precision
-// (twice as fast an inverse transform; a displacement error of about 1e-7 of itself), and ARAP
-// starting from the previous frame (a drag moves the handle a little per frame).
+// (twice as fast an inverse transform; a displacement error of about 1e-7 of itself), ARAP
+// starting from the previous frame (a drag moves the handle a little per frame), and the
+// transfer's factorisation in the background (displacements meanwhile; "state" says
+// "detail_pending").
 inline DeformOptions editor_deform_options() {
   DeformOptions o;
   o.float32_basis = true;
+  o.background_transfer = true;  // a selection change waits for no factorisation
   o.arap.warm_start = true;
   return o;
 }
@@ -87,10 +92,14 @@ inline constexpr double kReuseResidual = 1e-2;
 
 class EditorSession {
  public:
-  // `send(binary, data)` delivers one message to the browser.
+  // `send(binary, data)` delivers one message to the browser; `post(job)` runs a job on the
+  // session's thread later (from any thread): the transfer's background factorisation says
+  // so when it is ready, and the session then sends the result with the transfer's details
+  // (without `post`, that result comes with the next request).
   using Send = std::function<void(bool binary, std::string data)>;
+  using Post = std::function<void(std::function<void()> job)>;
 
-  EditorSession(EditorConfig config, Send send);
+  EditorSession(EditorConfig config, Send send, Post post = {});
   ~EditorSession();
 
   // Computes (or loads) the basis and builds the deformer, then announces the mesh. Throws
@@ -132,12 +141,15 @@ class EditorSession {
   void send_selection();
   void send_state();
   void send_error(const std::string& message, bool cancelled = false);
+  void watch_detail();  // the deformer's background transfer calls detail_ready() via post_
+  void detail_ready();
   // prepare_basis() with progress messages, abandoned by cancel().
   PreparedBasis compute_basis(const TriangleMesh& mesh, int modes);
   void build(LoadedMesh mesh, std::string name, int modes, const DeformOptions& options);
 
   EditorConfig config_;
   Send send_;
+  Post post_;
   std::atomic<bool> computing_{false}, cancelled_{false};
   std::string request_;     // the type of the message being handled
   std::string last_error_;  // of the last request that failed

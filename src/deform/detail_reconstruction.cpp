@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <condition_variable>
+#include <mutex>
+#include <optional>
+#include <thread>
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Geometry>
@@ -147,6 +151,65 @@ struct DetailReconstruction::Poisson {
   Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> faces;  // sorted by their first row
   // Per-frame buffers, kept: a fresh allocation of this size costs its page faults each frame.
   RowMajor positions, face_normals, x;
+
+  void build(const TriangleMesh& detailed, const Vertices& base);  // all but the anchors
+  void anchor(const std::vector<int>& vertices);                   // factors
+};
+
+// The background thread of a Transfer: builds the Poisson system, then factors the newest anchor
+// set whenever one is pending (sets that arrive while it works replace each other: only the
+// newest is factored).
+struct DetailReconstruction::Background {
+  void run(Poisson& poisson, TriangleMesh mesh, Vertices base) {
+    try {
+      poisson.build(mesh, base);
+    } catch (...) {
+      std::lock_guard lock(mutex);
+      error = std::current_exception();
+    }
+    mesh = {};
+    base.resize(0, 3);
+    std::unique_lock lock(mutex);
+    while (true) {
+      wake.wait(lock, [&] { return stop || (pending && !error); });
+      if (stop) return;
+      const std::vector<int> anchors = std::move(*pending);
+      pending.reset();
+      const long version = requested;
+      lock.unlock();
+      std::exception_ptr failed;
+      try {
+        poisson.anchor(anchors);
+      } catch (...) {
+        failed = std::current_exception();
+      }
+      lock.lock();
+      error = failed;
+      if (version == requested) {
+        done = version;
+        if (on_ready && !error) on_ready();
+      }
+      wake.notify_all();
+    }
+  }
+
+  std::mutex mutex;
+  std::condition_variable wake;  // a new anchor set or stop (to the thread); done (to wait())
+  std::optional<std::vector<int>> pending;  // the newest anchors, not yet taken
+  long requested = 0, done = 0;             // anchor sets asked for, and the one factored
+  bool stop = false;
+  std::exception_ptr error;
+  std::function<void()> on_ready;
+  std::thread thread;
+
+  ~Background() {  // waits for a factorisation under way
+    {
+      std::lock_guard lock(mutex);
+      stop = true;
+    }
+    wake.notify_all();
+    thread.join();
+  }
 };
 
 namespace {
@@ -192,8 +255,8 @@ __attribute__((target_clones("avx2", "default"))) void add_product(const RowSpar
 }  // namespace
 
 DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const Vertices& base,
-                                           DetailMethod method)
-    : method_(method), faces_(detailed.F) {
+                                           DetailMethod method, bool background)
+    : method_(method), applied_(method), faces_(detailed.F) {
   if (base.rows() != detailed.V.rows()) {
     throw InputError("details: the base has " + std::to_string(base.rows()) +
                      " vertices, the mesh " + std::to_string(detailed.V.rows()));
@@ -231,71 +294,81 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
       details_ = offset;
       break;
     }
-    case DetailMethod::Transfer: {
+    case DetailMethod::Transfer:
       poisson_ = std::make_unique<Poisson>();
-      Poisson& p = *poisson_;
-      const Sparse G = gradient_operator(detailed);
-      const Eigen::VectorXd areas = face_areas(detailed);
-      const Eigen::MatrixX3d J = G * detailed.V;  // rows 3f..3f+2: gradients of x, y, z
-      const int nf = detailed.num_faces();
-      const int n = detailed.num_vertices();
-      p.system = std::make_unique<detail::AnchoredPoisson>(cotan_stiffness(detailed));
-      p.order = p.system->order();
-      p.rank.resize(n);
-      for (int k = 0; k < n; ++k) p.rank[p.order[k]] = k;
-      std::vector<int> face_order(nf), first(nf);
-      for (int f = 0; f < nf; ++f) {
-        face_order[f] = f;
-        first[f] = std::min({p.rank[faces_(f, 0)], p.rank[faces_(f, 1)], p.rank[faces_(f, 2)]});
+      if (!background) {
+        poisson_->build(detailed, base);
+        break;
       }
-      std::stable_sort(face_order.begin(), face_order.end(),
-                       [&](int a, int b) { return first[a] < first[b]; });
-      std::vector<int> slot(nf);  // face f of the mesh is face slot[f] here
-      for (int g = 0; g < nf; ++g) slot[face_order[g]] = g;
-      const std::vector<int> donors = transfer_donors(detailed, base);
-      p.faces.resize(nf, 3);
-      std::vector<Eigen::Triplet<double>> edges, normals;
-      p.constant = RowMajor::Zero(n, 3);
-      for (int g = 0; g < nf; ++g) {  // face g here is face f of the mesh
-        const int f = face_order[g];
-        for (int k = 0; k < 3; ++k) p.faces(g, k) = p.rank[faces_(f, k)];
-        Eigen::Matrix3d corners = Eigen::Matrix3d::Zero();  // rows: corners, columns: x, y, z
-        for (int k = 0; k < 3; ++k)
-          for (int d = 0; d < 3; ++d) corners(k, d) = G.coeff(3 * f + d, faces_(f, k));
-        const Eigen::Matrix3d Q = areas[f] * corners * J.middleRows<3>(3 * f);
-        const int donor = donors[f];
-        if (donor < 0) {  // S_f = I
-          for (int r = 0; r < 3; ++r) p.constant.row(p.faces(g, r)) += Q.row(r);
-          continue;
-        }
-        // S_f = B'_d B_d^-1 of the donor d (f itself where its base triangle is sound).
-        const Eigen::Matrix3d P = Q * triangle_frame(base, faces_, donor).inverse().transpose();
-        const int a = p.rank[faces_(donor, 0)], b = p.rank[faces_(donor, 1)],
-                  c = p.rank[faces_(donor, 2)];
-        for (int r = 0; r < 3; ++r) {  // P(r, :) [c' - a', b' - a', n']^T
-          const int v = p.faces(g, r);
-          edges.emplace_back(v, c, P(r, 0));
-          edges.emplace_back(v, b, P(r, 1));
-          edges.emplace_back(v, a, -P(r, 0) - P(r, 1));
-          normals.emplace_back(v, slot[donor], P(r, 2));
-        }
-      }
-      p.edges.resize(n, n);
-      p.edges.setFromTriplets(edges.begin(), edges.end());
-      p.normals.resize(n, nf);
-      p.normals.setFromTriplets(normals.begin(), normals.end());
+      details_ = offset;
+      background_ = std::make_unique<Background>();
+      background_->thread =
+          std::thread([b = background_.get(), p = poisson_.get(), mesh = detailed, base]() mutable {
+            b->run(*p, std::move(mesh), std::move(base));
+          });
       break;
-    }
   }
 }
 
-DetailReconstruction::~DetailReconstruction() = default;
-DetailReconstruction::DetailReconstruction(DetailReconstruction&&) noexcept = default;
-DetailReconstruction& DetailReconstruction::operator=(DetailReconstruction&&) noexcept = default;
+void DetailReconstruction::Poisson::build(const TriangleMesh& detailed, const Vertices& base) {
+  Poisson& p = *this;
+  const Sparse G = gradient_operator(detailed);
+  const Eigen::VectorXd areas = face_areas(detailed);
+  const Eigen::MatrixX3d J = G * detailed.V;  // rows 3f..3f+2: gradients of x, y, z
+  const int nf = detailed.num_faces();
+  const int n = detailed.num_vertices();
+  p.system = std::make_unique<detail::AnchoredPoisson>(cotan_stiffness(detailed));
+  p.order = p.system->order();
+  p.rank.resize(n);
+  for (int k = 0; k < n; ++k) p.rank[p.order[k]] = k;
+  std::vector<int> face_order(nf), first(nf);
+  for (int f = 0; f < nf; ++f) {
+    face_order[f] = f;
+    first[f] =
+        std::min({p.rank[detailed.F(f, 0)], p.rank[detailed.F(f, 1)], p.rank[detailed.F(f, 2)]});
+  }
+  std::stable_sort(face_order.begin(), face_order.end(),
+                   [&](int a, int b) { return first[a] < first[b]; });
+  std::vector<int> slot(nf);  // face f of the mesh is face slot[f] here
+  for (int g = 0; g < nf; ++g) slot[face_order[g]] = g;
+  const std::vector<int> donors = transfer_donors(detailed, base);
+  p.faces.resize(nf, 3);
+  std::vector<Eigen::Triplet<double>> edges, normals;
+  p.constant = RowMajor::Zero(n, 3);
+  for (int g = 0; g < nf; ++g) {  // face g here is face f of the mesh
+    const int f = face_order[g];
+    for (int k = 0; k < 3; ++k) p.faces(g, k) = p.rank[detailed.F(f, k)];
+    Eigen::Matrix3d corners = Eigen::Matrix3d::Zero();  // rows: corners, columns: x, y, z
+    for (int k = 0; k < 3; ++k)
+      for (int d = 0; d < 3; ++d) corners(k, d) = G.coeff(3 * f + d, detailed.F(f, k));
+    const Eigen::Matrix3d Q = areas[f] * corners * J.middleRows<3>(3 * f);
+    const int donor = donors[f];
+    if (donor < 0) {  // S_f = I
+      for (int r = 0; r < 3; ++r) p.constant.row(p.faces(g, r)) += Q.row(r);
+      continue;
+    }
+    // S_f = B'_d B_d^-1 of the donor d (f itself where its base triangle is sound).
+    const Eigen::Matrix3d P = Q * triangle_frame(base, detailed.F, donor).inverse().transpose();
+    const int a = p.rank[detailed.F(donor, 0)], b = p.rank[detailed.F(donor, 1)],
+              c = p.rank[detailed.F(donor, 2)];
+    for (int r = 0; r < 3; ++r) {  // P(r, :) [c' - a', b' - a', n']^T
+      const int v = p.faces(g, r);
+      edges.emplace_back(v, c, P(r, 0));
+      edges.emplace_back(v, b, P(r, 1));
+      edges.emplace_back(v, a, -P(r, 0) - P(r, 1));
+      normals.emplace_back(v, slot[donor], P(r, 2));
+    }
+  }
+  p.edges.resize(n, n);
+  p.edges.setFromTriplets(edges.begin(), edges.end());
+  p.normals.resize(n, nf);
+  p.normals.setFromTriplets(normals.begin(), normals.end());
+}
 
-void DetailReconstruction::set_anchors(const std::vector<int>& vertices) {
-  if (method_ != DetailMethod::Transfer) return;
-  Poisson& p = *poisson_;
+DetailReconstruction::~DetailReconstruction() = default;
+
+void DetailReconstruction::Poisson::anchor(const std::vector<int>& vertices) {
+  Poisson& p = *this;
   p.anchors.resize(vertices.size());
   for (size_t i = 0; i < vertices.size(); ++i) p.anchors[i] = p.rank[vertices[i]];
   const int n = static_cast<int>(p.order.size());
@@ -315,7 +388,40 @@ void DetailReconstruction::set_anchors(const std::vector<int>& vertices) {
   p.coupling.setFromTriplets(coupling.begin(), coupling.end());
 }
 
+void DetailReconstruction::set_anchors(const std::vector<int>& vertices) {
+  if (method_ != DetailMethod::Transfer) return;
+  if (!background_) return poisson_->anchor(vertices);
+  {
+    std::lock_guard lock(background_->mutex);
+    background_->pending = vertices;
+    ++background_->requested;
+  }
+  background_->wake.notify_all();
+}
+
+bool DetailReconstruction::ready() const {
+  if (!background_) return true;
+  std::lock_guard lock(background_->mutex);
+  if (background_->error) std::rethrow_exception(background_->error);
+  return background_->done == background_->requested;
+}
+
+void DetailReconstruction::wait() const {
+  if (!background_) return;
+  std::unique_lock lock(background_->mutex);
+  background_->wake.wait(
+      lock, [&] { return background_->error || background_->done == background_->requested; });
+  if (background_->error) std::rethrow_exception(background_->error);
+}
+
+void DetailReconstruction::on_ready(std::function<void()> callback) {
+  if (!background_) return;
+  std::lock_guard lock(background_->mutex);
+  background_->on_ready = std::move(callback);
+}
+
 Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& anchors) {
+  applied_ = method_;
   switch (method_) {
     case DetailMethod::None:
       return s;
@@ -341,6 +447,10 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
       return out;
     }
     case DetailMethod::Transfer:
+      if (!ready()) {
+        applied_ = DetailMethod::Displacement;
+        return s + details_;
+      }
       break;
   }
   Poisson& p = *poisson_;

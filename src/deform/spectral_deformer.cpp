@@ -96,7 +96,8 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
     spatial_ = std::make_unique<SpatialSolver>(mesh_, options_);
   }
   setup_.reduced_system = clock.lap();
-  details_ = std::make_unique<DetailReconstruction>(mesh_, base_, options_.detail);
+  details_ = std::make_unique<DetailReconstruction>(mesh_, base_, options_.detail,
+                                                    options_.background_transfer);
   setup_.detail_factorization = clock.lap();
   deformed_base_ = base_;
 }
@@ -127,7 +128,9 @@ void SpectralDeformer::set_selection(const Selection& selection) {
   }
   clock.lap();
   details_->set_anchors(constrained_.vertices);
-  if (options_.detail == DetailMethod::Transfer) setup_.detail_factorization = clock.lap();
+  if (options_.detail == DetailMethod::Transfer && !options_.background_transfer) {
+    setup_.detail_factorization = clock.lap();
+  }
   setup_.selection = total.lap();
   detail_targets_.resize(0, 3);
   state_ = ArapState{};  // warm starts continue a drag, not across selections

@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <atomic>
 
 #include "specdeform/deform/deformation_quality.h"
 #include "specdeform/deform/spectral_deformer.h"
 #include "specdeform/exceptions.h"
+#include "specdeform/mesh/generate.h"
 #include "specdeform/mesh/mesh_info.h"
 #include "support/corpus.h"
 
@@ -136,6 +138,84 @@ TEST(DetailReconstruction, UnconstrainedPiecesStayAndNothingFolds) {
           << e.what();
     }
   }
+}
+
+// In the background, a transfer adds displacements until the newest anchors are factored, then
+// gives exactly what the synchronous one gives; anchor sets that arrive while it works replace
+// each other.
+TEST(DetailReconstruction, BackgroundTransferSwitchesOverToTheSameResult) {
+  const TriangleMesh mesh = make_bumpy_bar();
+  const auto h = harmonics(mesh, 40);
+  DeformOptions o;
+  o.energy = DeformEnergy::Linear;
+  SpectralDeformer deformer(mesh, h, o);
+  const Vertices& base = deformer.base();
+  const Vertices turned = moved(
+      base, Eigen::Translation3d(0.1, 0.2, 0.0) * Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()));
+  std::vector<int> first, second;
+  for (int i = 0; i < mesh.num_vertices(); ++i) (mesh.V(i, 0) < 0.5 ? first : second).push_back(i);
+  const auto targets = [&](const std::vector<int>& anchors) {
+    Eigen::MatrixX3d t(anchors.size(), 3);
+    for (size_t k = 0; k < anchors.size(); ++k)
+      t.row(k) = turned.row(anchors[k]) + (mesh.V - base).row(anchors[k]);
+    return t;
+  };
+  DetailReconstruction now(mesh, base, DetailMethod::Transfer);
+  now.set_anchors(second);
+  const Vertices expected = now.apply(turned, targets(second));
+
+  std::atomic<int> calls = 0;
+  DetailReconstruction later(mesh, base, DetailMethod::Transfer, true);
+  later.on_ready([&] { ++calls; });
+  EXPECT_TRUE(later.ready());  // no anchors asked for yet
+  later.set_anchors(first);
+  later.set_anchors(second);  // the newest wins
+  if (!later.ready()) {
+    const Vertices meanwhile = later.apply(turned, targets(second));
+    EXPECT_EQ(later.applied(), DetailMethod::Displacement);
+    EXPECT_LT((meanwhile - (turned + mesh.V - base)).cwiseAbs().maxCoeff(), 1e-15);
+  }
+  later.wait();
+  EXPECT_TRUE(later.ready());
+  EXPECT_GE(calls.load(), 1);
+  const Vertices out = later.apply(turned, targets(second));
+  EXPECT_EQ(later.applied(), DetailMethod::Transfer);
+  EXPECT_LT((out - expected).cwiseAbs().maxCoeff(), 1e-12);
+  later.set_anchors(first);  // destroyed while it may still work: waits, no crash
+}
+
+// The deformer in the background: the same result once the transfer is ready, and displacements
+// (its own result with DetailMethod::Displacement) before.
+TEST(DetailReconstruction, DeformerWithABackgroundTransfer) {
+  const TriangleMesh mesh = make_bumpy_bar();
+  const auto h = harmonics(mesh, 40);
+  Selection selection;
+  selection.handles.resize(1);
+  for (int i = 0; i < mesh.num_vertices(); ++i) {
+    if (mesh.V(i, 0) < 0.3) selection.fixed.push_back(i);
+    if (mesh.V(i, 0) > 3.7) selection.handles[0].push_back(i);
+  }
+  const std::vector<Eigen::Affine3d> turn = {Eigen::Affine3d(
+      Eigen::Translation3d(-0.5, 1.0, 0.2) * Eigen::AngleAxisd(0.6, Eigen::Vector3d::UnitZ()))};
+  DeformOptions o;
+  SpectralDeformer sync(mesh, h, o);
+  sync.set_selection(selection);
+  const Vertices expected = sync.solve(turn);
+  o.detail = DetailMethod::Displacement;
+  SpectralDeformer displaced(mesh, h, o);
+  displaced.set_selection(selection);
+  const Vertices meanwhile = displaced.solve(turn);
+  o.detail = DetailMethod::Transfer;
+  o.background_transfer = true;
+  SpectralDeformer deformer(mesh, h, o);
+  deformer.set_selection(selection);
+  const Vertices first = deformer.solve(turn);
+  const bool pending = deformer.applied_detail() == DetailMethod::Displacement;
+  EXPECT_LT((first - (pending ? meanwhile : expected)).cwiseAbs().maxCoeff(), 1e-12);
+  deformer.wait_for_detail();
+  EXPECT_FALSE(deformer.detail_pending());
+  EXPECT_LT((deformer.solve(turn) - expected).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_EQ(deformer.applied_detail(), DetailMethod::Transfer);
 }
 
 }  // namespace

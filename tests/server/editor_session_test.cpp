@@ -1,8 +1,11 @@
 #include "editor_session.h"
 
 #include <algorithm>
+#include <condition_variable>
 #include <cstring>
+#include <deque>
 #include <fstream>
+#include <mutex>
 #include <numeric>
 #include <thread>
 
@@ -33,10 +36,12 @@ GroupSelection plain(Selection s) {
 }
 
 // The editor's options with the linear energy: one solve per frame, the same result for the
-// same transforms whatever came before (ARAP starts from the previous frame).
+// same transforms whatever came before (ARAP starts from the previous frame); the transfer
+// factored before the frame (EditorSessionBackground: in the background).
 DeformOptions linear_options() {
   DeformOptions o = editor_deform_options();
   o.energy = DeformEnergy::Linear;
+  o.background_transfer = false;
   return o;
 }
 
@@ -159,6 +164,73 @@ TEST_F(EditorSessionTest, FramesMeetTheHandleTargets) {
   // The identity gives the rest shape back (to float precision).
   session_->handle(true, frame(Eigen::Affine3d::Identity(), 2));
   EXPECT_LT((last_frame() - rest_).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+// The transfer factored in the background (the editor's default): after a selection, frames
+// come with displacements until the factorisation is ready; the session is then told (post) and
+// sends the frame with the transfer's details, the same as a session that factors at once.
+TEST(EditorSessionBackground, TheTransfersFrameFollowsItsFactorisation) {
+  std::mutex mutex;
+  std::condition_variable posted;
+  std::deque<std::function<void()>> jobs;
+  std::vector<Sent> sent[2];
+  DeformOptions o = linear_options();
+  std::unique_ptr<EditorSession> sessions[2];
+  for (int k = 0; k < 2; ++k) {
+    o.background_transfer = k == 1;
+    sessions[k] = std::make_unique<EditorSession>(
+        EditorConfig{.modes = 30, .options = o},
+        [&sent, k](bool binary, std::string data) {
+          sent[k].push_back({binary, std::move(data)});
+        },
+        [&](std::function<void()> job) {
+          std::lock_guard lock(mutex);
+          jobs.push_back(std::move(job));
+          posted.notify_all();
+        });
+    LoadedMesh mesh;
+    mesh.mesh = make_icosphere(5);
+    mesh.info = identity_read_info(mesh.mesh);
+    sessions[k]->open(std::move(mesh), "sphere.obj");
+  }
+  const Vertices rest = make_icosphere(5).V;
+  Selection selection;
+  selection.handles.resize(1);
+  for (int i = 0; i < rest.rows(); ++i) {
+    if (rest(i, 2) > 0.7) selection.handles[0].push_back(i);
+    if (rest(i, 2) < -0.7) selection.fixed.push_back(i);
+  }
+  const Eigen::Affine3d turn(Eigen::Translation3d(0.1, 0.0, 0.3) *
+                             Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitX()));
+  for (auto& session : sessions) {
+    session->handle(true, encode_selection(plain(selection), Tag::Selection));
+    session->handle(true, encode_frame({1, {turn}}));
+  }
+  {
+    std::unique_lock lock(mutex);
+    ASSERT_TRUE(posted.wait_for(lock, std::chrono::seconds(30), [&] { return !jobs.empty(); }));
+  }
+  while (true) {
+    std::function<void()> job;
+    {
+      std::lock_guard lock(mutex);
+      if (jobs.empty()) break;
+      job = std::move(jobs.front());
+      jobs.pop_front();
+    }
+    job();
+  }
+  const auto last = [&](int k, bool binary) -> const std::string& {
+    for (auto it = sent[k].rbegin(); it != sent[k].rend(); ++it)
+      if (it->binary == binary && (!binary || message_tag(it->data) == Tag::FrameResult))
+        return it->data;
+    throw std::runtime_error("nothing sent");
+  };
+  const Vertices expected = decode_frame_positions(last(0, true), rest);
+  const Vertices shown = decode_frame_positions(last(1, true), rest);
+  EXPECT_LT((shown - expected).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_FALSE(Json::parse(last(1, false))["detail_pending"]);
+  EXPECT_FALSE(Json::parse(last(0, false))["detail_pending"]);
 }
 
 TEST_F(EditorSessionTest, BadMessagesAreAnsweredAndChangeNothing) {

@@ -265,7 +265,9 @@ export class Panel {
         case 'empty': return ['No mesh is open: open one (Open mesh…, or drop a file) or the Demo', 'busy'];
         case 'loading': return [`${phase.stage}… ${Math.round(100 * phase.fraction)}%`, 'busy'];
         case 'busy': return [`${phase.what}: waiting for the server…`, 'busy'];
-        case 'ready': return [r ? `${r.name}: ready` : 'ready', 'ready'];
+        case 'ready': return s.server?.detail_pending
+          ? [`${r ? `${r.name}: ` : ''}working: factoring the transfer's details (displacements until then)`, 'busy']
+          : [r ? `${r.name}: ready` : 'ready', 'ready'];
       }
     })();
     status.textContent = text;

@@ -78,6 +78,7 @@ export interface StateMessage {
   pin_error: number;
   free_pieces: number; // pieces without a constrained vertex
   constrained_piece_modes: number[]; // the basis's modes on each piece with a handle or fixed vertex
+  detail_pending: boolean; // the transfer's factorisation runs on the server: displacements meanwhile
   pose: number;
 }
 

@@ -78,6 +78,8 @@ export class EditorState {
   private restoring = false; // the server sent an empty selection where this page has one
   private restoreSettings: P.ClientText | null = null;
   private awaitingStates = 0; // requests sent whose "state" (or "empty", or error) is to come
+  private selectionsInFlight = 0; // selections sent, not answered yet
+  private selectionWaiting = false; // a selection made since: sent when they are answered
   private restorePending = false; // a restored selection is on its way back
 
   constructor(readonly viewer: Viewer) {
@@ -129,7 +131,13 @@ export class EditorState {
   }
 
   // `fit`: pinned groups whose transform the server fits; `echo`: it sends the selection back.
+  // Strokes coalesce: a plain selection made while another is on its way waits, and only the
+  // newest goes when the server answers (no queue of rebuilds behind the pointer).
   sendSelection(fit: Set<number> = new Set(), echo = false): void {
+    if (fit.size === 0 && !echo && this.selectionsInFlight > 0) {
+      this.selectionWaiting = true;
+      return;
+    }
     const s: P.Selection = {
       groups: this.groups.map((g, k) => ({
         vertices: new Uint32Array(0),
@@ -148,8 +156,10 @@ export class EditorState {
     });
     s.groups.forEach((g, k) => (g.vertices = Uint32Array.from(lists[k])));
     s.fixed = Uint32Array.from(fixed);
-    if (this.connection.send(P.encodeSelection(s))) ++this.awaitingStates;
-    else this.note('the selection was not sent: not connected (it is sent again on reconnection)', 'error');
+    if (this.connection.send(P.encodeSelection(s))) {
+      ++this.awaitingStates;
+      ++this.selectionsInFlight;
+    } else this.note('the selection was not sent: not connected (it is sent again on reconnection)', 'error');
   }
 
   // Sends the transforms as they are now; `preview`: answered with the preview's vertices.
@@ -189,7 +199,8 @@ export class EditorState {
   }
 
   settled(): boolean {
-    return this.outstanding === null && this.pendingDraw === null && this.awaitingStates === 0 && !this.painting &&
+    return this.outstanding === null && this.pendingDraw === null && this.awaitingStates === 0 &&
+      !this.selectionWaiting && !this.server?.detail_pending && !this.painting &&
       !this.normalsBusy.full && this.phase.kind !== 'busy';
   }
 
@@ -211,12 +222,14 @@ export class EditorState {
       this.restoreChecked = !this.wasOpen; // after a reconnection: does the server still have the edit?
       this.wasOpen = true;
       this.awaitingStates = 1;
+      this.selectionsInFlight = 0;
       this.connection.send({ type: 'hello' });
     } else if (s.kind === 'closed') {
       // The banner stays while disconnected; the log says when it started.
       if (this.phase.kind !== 'disconnected') this.note(`disconnected: ${s.reason}`);
       this.phase = { kind: 'disconnected', reason: s.reason, retryAt: s.retryAt };
       this.awaitingStates = 0;
+      this.selectionsInFlight = 0;
     } else if (this.phase.kind !== 'disconnected') {
       this.phase = { kind: 'connecting' };
     }
@@ -243,6 +256,7 @@ export class EditorState {
         break;
       case 'error':
         if (STATE_REQUESTS.has(m.request)) this.awaitingStates = Math.max(0, this.awaitingStates - 1);
+        if (m.request === 'selection') this.selectionAnswered();
         this.note(m.cancelled || m.message.startsWith(`${m.request}:`) ? m.message : `${requestName(m.request)}: ${m.message}`,
           m.cancelled ? 'info' : 'error');
         this.phase = this.ready ? { kind: 'ready' } : { kind: 'empty' };
@@ -420,8 +434,17 @@ export class EditorState {
     this.paint();
   }
 
+  private selectionAnswered(): void {
+    this.selectionsInFlight = Math.max(0, this.selectionsInFlight - 1);
+    if (this.selectionWaiting && this.selectionsInFlight === 0) {
+      this.selectionWaiting = false;
+      this.sendSelection();
+    }
+  }
+
   private adoptState(m: P.StateMessage): void {
     if (STATE_REQUESTS.has(m.request)) this.awaitingStates = Math.max(0, this.awaitingStates - 1);
+    if (m.request === 'selection') this.selectionAnswered();
     if (!this.restoreChecked) {
       this.restoreChecked = true;
       const restarted = m.groups.length === 0 && m.fixed === 0 && !m.undo;

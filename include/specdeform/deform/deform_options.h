@@ -71,6 +71,10 @@ struct DeformOptions {
   DetailMethod detail = DetailMethod::Transfer;
   UnconstrainedPieces unconstrained = UnconstrainedPieces::Follow;
   bool float32_basis = false;  // keep the basis in single precision (faster frames)
+  // Transfer: build and factor its Poisson system on a background thread; until the last
+  // selection's factorisation is ready, frames add the details as displacements
+  // (SpectralDeformer::detail_pending). For interactive front ends.
+  bool background_transfer = false;
 
   // Throws InputError, naming the field, for a value out of range.
   void validate() const;

@@ -17,7 +17,10 @@
 //                  exact targets. K is analysed once, factored (CHOLMOD LDL^T) for the first
 //                  anchor set and then updated by the anchors that change (row additions and
 //                  deletions); a frame is O(f) plus one back-substitution with 3 columns, both
-//                  on two threads.
+//                  on two threads. In the background (for interactive front ends), a thread
+//                  of its own builds the system and factors each new anchor set while
+//                  apply() adds the details as displacements; apply() switches to the
+//                  transfer once the newest anchors are factored (a million vertices: 2-3 s).
 // Where the low-pass collapsed the base (a small piece keeps only its constant mode among the
 // first m and its base is a point; thin tips and slivers nearly so), a base triangle's or
 // one-ring's frame is rounding noise. Such a triangle (its base edges below 1e-3 of the detailed
@@ -28,6 +31,7 @@
 // With s' = s every method returns x (to round-off).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -40,30 +44,44 @@ namespace specdeform {
 
 class DetailReconstruction {
  public:
-  DetailReconstruction(const TriangleMesh& detailed, const Vertices& base, DetailMethod method);
-  ~DetailReconstruction();
-  DetailReconstruction(DetailReconstruction&&) noexcept;
-  DetailReconstruction& operator=(DetailReconstruction&&) noexcept;
+  // background: Transfer only, see above; the thread starts here.
+  DetailReconstruction(const TriangleMesh& detailed, const Vertices& base, DetailMethod method,
+                       bool background = false);
+  ~DetailReconstruction();  // waits for a background factorisation under way
+  DetailReconstruction(const DetailReconstruction&) = delete;
+  DetailReconstruction& operator=(const DetailReconstruction&) = delete;
 
-  // Transfer: factors the Poisson system with these vertices anchored. Other methods: nothing.
+  // Transfer: factors the Poisson system with these vertices anchored (in the background: hands
+  // them to the thread and returns). Other methods: nothing.
   void set_anchors(const std::vector<int>& vertices);
+  // Whether apply() uses the method asked for: false while a background factorisation of the
+  // newest anchors runs. ready() and wait() rethrow the background thread's error (a singular
+  // system).
+  bool ready() const;
+  void wait() const;
+  // Called on the background thread, its lock held (post a message; do not call back), each
+  // time the newest anchors' factorisation completes.
+  void on_ready(std::function<void()> callback);
 
   // anchor_positions: exact positions of the anchors (n' x 3, Transfer only). Reuses buffers
   // of the previous call (not reentrant).
   Vertices apply(const Vertices& deformed_base, const Eigen::MatrixX3d& anchor_positions);
 
   DetailMethod method() const { return method_; }
+  DetailMethod applied() const { return applied_; }  // by the last apply()
 
   struct Poisson;  // the Transfer method's precomputed system
 
  private:
-  DetailMethod method_;
+  struct Background;
+  DetailMethod method_, applied_;
   Faces faces_;
   Vertices details_;                    // x - s (Displacement, Frames)
   std::vector<int> ring_start_, ring_;  // Frames: each vertex's one-ring (empty: collapsed)
   Vertices base_;                       // Frames: s
   Eigen::Matrix<double, Eigen::Dynamic, 3> base_normals_;  // Frames: the vertex normals of s
   std::unique_ptr<Poisson> poisson_;                       // Transfer
+  std::unique_ptr<Background> background_;                 // after poisson_: stopped before it goes
 };
 
 }  // namespace specdeform

@@ -22,6 +22,7 @@
 //   Vertices frame = deformer.solve({Eigen::Affine3d(Eigen::Translation3d(0, 0.1, 0))});
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -49,6 +50,7 @@ struct SetupTimings {
                                       // last selection
   double detail_factorization = 0.0;  // Transfer: Poisson analysis (once per mesh), then the
                                       // factorisation or its update for the last selection
+                                      // (background_transfer: none, that runs aside)
   double selection = 0.0;             // the whole of the last set_selection()
 };
 
@@ -103,6 +105,14 @@ class SpectralDeformer {
   // The basis's modes on each piece that has a constrained vertex in the last selection, in
   // the order of the pieces' first vertices (one entry, all the modes, for a mesh of one piece).
   const std::vector<int>& constrained_piece_modes() const { return constrained_piece_modes_; }
+
+  // options().background_transfer (DetailReconstruction's background): whether the transfer's
+  // factorisation for the last selection still runs (solve() adds displacements meanwhile),
+  // waiting for it, and a callback on the background thread when it completes.
+  bool detail_pending() const { return !details_->ready(); }
+  void wait_for_detail() const { details_->wait(); }
+  void on_detail_ready(std::function<void()> callback) { details_->on_ready(std::move(callback)); }
+  DetailMethod applied_detail() const { return details_->applied(); }  // by the last solve()
 
  private:
   TriangleMesh mesh_;
