@@ -117,8 +117,8 @@ CoarseSpace partition_of_unity(const Sparse& lengths, int samples, double suppor
   out.radius = *std::max_element(nearest.begin(), nearest.end());
   const double rho = support * out.radius;
 
-  // Column j of P: seed j's bump, by a Dijkstra limited to rho, its rows sorted; the seeds
-  // split between two threads.
+  // Column j of P: seed j's bump, by a Dijkstra limited to rho (its entries in the order
+  // settled); the seeds split between two threads.
   const int N = static_cast<int>(seeds.size());
   std::vector<std::vector<std::pair<int, double>>> columns(N);
   const auto bumps = [&](int begin, int end) {
@@ -131,29 +131,35 @@ CoarseSpace partition_of_unity(const Sparse& lengths, int samples, double suppor
       });
       for (const auto& [i, value] : column) distance[i] = kInfinity;
       std::erase_if(column, [](const auto& entry) { return entry.second <= 0.0; });
-      std::sort(column.begin(), column.end());
     }
   };
   run_pair([&] { bumps(0, N / 2); }, [&] { bumps(N / 2, N); });
-  // Assembled in place, each entry divided by its row's sum (the partition of unity).
-  Sparse& P = out.prolongation;
-  P.resize(n, N);
-  Eigen::Index entries = 0;
-  for (const auto& column : columns) entries += static_cast<Eigen::Index>(column.size());
-  P.resizeNonZeros(entries);
-  Eigen::VectorXd row_sums = Eigen::VectorXd::Zero(n);
-  Eigen::Index k = 0;
+  // Row-major by counting (each row's entries in column order), each entry divided by its
+  // row's sum (the partition of unity); then the column-major copy the same way.
+  Eigen::SparseMatrix<double, Eigen::RowMajor>& R = out.rows;
+  R.resize(n, N);
+  std::vector<int> fill(n + 1, 0);
+  for (const auto& column : columns)
+    for (const auto& entry : column) ++fill[entry.first + 1];
+  for (int i = 0; i < n; ++i) fill[i + 1] += fill[i];
+  R.resizeNonZeros(fill[n]);
+  std::copy(fill.begin(), fill.end(), R.outerIndexPtr());
   for (int j = 0; j < N; ++j) {
-    P.outerIndexPtr()[j] = static_cast<int>(k);
     for (const auto& [i, value] : columns[j]) {
-      P.innerIndexPtr()[k] = i;
-      P.valuePtr()[k++] = value;
-      row_sums[i] += value;
+      const int at = fill[i]++;
+      R.innerIndexPtr()[at] = j;
+      R.valuePtr()[at] = value;
     }
     columns[j] = {};
   }
-  P.outerIndexPtr()[N] = static_cast<int>(k);
-  for (k = 0; k < entries; ++k) P.valuePtr()[k] /= row_sums[P.innerIndexPtr()[k]];
+  for (int i = 0; i < n; ++i) {
+    const auto row = R.row(i);
+    const double sum = row.sum();
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(R, i); it; ++it) {
+      it.valueRef() /= sum;
+    }
+  }
+  out.prolongation = R;  // Eigen's transposition is the same counting
   return out;
 }
 

@@ -18,8 +18,9 @@
 namespace specdeform::detail {
 
 struct CoarseSpace {
-  Eigen::SparseMatrix<double> prolongation;  // P, n x N, rows sum to 1
-  double radius = 0.0;                       // r, in the units of the edge lengths
+  Eigen::SparseMatrix<double> prolongation;           // P, n x N, rows sum to 1
+  Eigen::SparseMatrix<double, Eigen::RowMajor> rows;  // P again, row-major
+  double radius = 0.0;                                // r, in the units of the edge lengths
 };
 
 // lengths: n x n, symmetric, the length of edge ij at (i, j) (K's pattern; the diagonal is

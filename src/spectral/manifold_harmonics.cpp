@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "linalg/locality_order.h"
 #include "linalg/mass_operator.h"
 #include "specdeform/exceptions.h"
 #include "spectral/coarse_space.h"
@@ -55,6 +56,7 @@ void ManifoldHarmonicsPolicy::validate() const {
   require(multilevel_support > 1.0, "multilevel_support must be > 1");
   require(multilevel_reduction >= 1, "multilevel_reduction must be >= 1");
   require(multilevel_from >= 0, "multilevel_from must be >= 0");
+  require(reorder_from >= 0, "reorder_from must be >= 0");
   require(piece_min_modes >= 1 && piece_modes_limit >= 1,
           "piece_min_modes and piece_modes_limit must be >= 1");
 }
@@ -115,10 +117,30 @@ detail::Spectrum solve_connected(const Sparse& K, const Sparse& M_unit, const Sp
   return detail::solve_block_krylov(K, M_unit, o);
 }
 
-// Both overloads: `lengths` gives the multilevel solver's distances, or null.
+ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Sparse* lengths,
+                                     const ManifoldHarmonicsOptions& o);
+
+// Both overloads: `lengths` gives the multilevel solver's distances, or null. Meshes of
+// policy.reorder_from vertices or more are solved in a breadth-first numbering
+// (linalg/locality_order.h), the basis's rows put back in theirs.
 ManifoldHarmonics harmonics(const Sparse& K, const Sparse& M, const Sparse* lengths,
                             const ManifoldHarmonicsOptions& o) {
   o.validate();
+  if (K.rows() != K.cols() || M.rows() != K.rows() || M.cols() != K.rows()) {
+    throw InputError("manifold harmonics: K and M must be square matrices of the same size");
+  }
+  if (K.rows() < o.policy.reorder_from) return harmonics_in_order(K, M, lengths, o);
+  const auto P = detail::breadth_first_order(K);
+  const Sparse K_ordered = detail::renumbered(K, P), M_ordered = detail::renumbered(M, P);
+  const Sparse lengths_ordered = lengths ? detail::renumbered(*lengths, P) : Sparse();
+  ManifoldHarmonics h =
+      harmonics_in_order(K_ordered, M_ordered, lengths ? &lengths_ordered : nullptr, o);
+  detail::permute_rows_back(P, h.basis);
+  return h;
+}
+
+ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Sparse* lengths,
+                                     const ManifoldHarmonicsOptions& o) {
   const int n = static_cast<int>(K.rows());
   const int m = o.num_modes;
   if (K.rows() != K.cols() || M.rows() != n || M.cols() != n) {

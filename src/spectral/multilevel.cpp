@@ -28,12 +28,28 @@ using Mat = Eigen::MatrixXd;
 using Vec = Eigen::VectorXd;
 using Sparse = Eigen::SparseMatrix<double>;
 
-// P Z on two threads (P row-major, split by rows).
-Mat prolong(const Sparse& P, const Eigen::Ref<const Mat>& Z) {
-  const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = P;
-  Mat U(P.rows(), Z.cols());
+// P Z on two threads, P row-major: each row of U = P Z gathered into a tile of kTile rows
+// (row-major, m wide: the rows of Z it adds are contiguous), stored into U's columns a tile at
+// a time.
+Mat prolong(const Eigen::SparseMatrix<double, Eigen::RowMajor>& P, const Eigen::Ref<const Mat>& Z) {
+  constexpr Eigen::Index kTile = 64;
+  using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const RowMat Zr = Z;
+  const Eigen::Index m = Z.cols();
+  Mat U(P.rows(), m);
   split_in_two(P.rows(), [&](Eigen::Index begin, Eigen::Index end) {
-    U.middleRows(begin, end - begin).noalias() = rows.middleRows(begin, end - begin) * Z;
+    RowMat tile(kTile, m);
+    for (Eigen::Index first = begin; first < end; first += kTile) {
+      const Eigen::Index rows = std::min(kTile, end - first);
+      tile.setZero();
+      for (Eigen::Index r = 0; r < rows; ++r) {
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P, first + r); it;
+             ++it) {
+          tile.row(r) += it.value() * Zr.row(it.index());
+        }
+      }
+      U.middleRows(first, rows) = tile.topRows(rows);
+    }
   });
   return U;
 }
@@ -50,7 +66,7 @@ Spectrum solve_multilevel(const Sparse& K, const Sparse& M, const Sparse& length
       p.multilevel_support);
   const Sparse& P = coarse.prolongation;
   const int N = static_cast<int>(P.cols());
-  const Sparse Kc = galerkin_product(K, P), Mc = galerkin_product(M, P);
+  const auto [Kc, Mc] = galerkin_products(K, M, P, coarse.rows);
 
   // One pair more than m tells whether m ends inside a cluster.
   ManifoldHarmonicsOptions co = o;
@@ -66,7 +82,7 @@ Spectrum solve_multilevel(const Sparse& K, const Sparse& M, const Sparse& length
   ManifoldHarmonics h = compute_manifold_harmonics(Kc, Mc, co);
   report(o, 0.7, "prolongation");
   Spectrum out;
-  out.H = prolong(P, h.basis.leftCols(m));  // m columns only: no second n x m copy
+  out.H = prolong(coarse.rows, h.basis.leftCols(m));  // m columns only: no second n x m copy
   out.lambda = std::move(h.eigenvalues);
   out.cluster_truncated =
       out.lambda.size() > m &&

@@ -24,7 +24,7 @@ Sparse random_sparse(int rows, int cols, int per_column, std::mt19937_64& rng) {
 
 // Against the plain sparse product, for a symmetric A with and without off-diagonal entries,
 // with columns of P that share rows and an empty column.
-TEST(GalerkinProduct, MatchesTheSparseProduct) {
+TEST(GalerkinProducts, MatchTheSparseProducts) {
   std::mt19937_64 rng(7);
   const Sparse B = random_sparse(400, 400, 5, rng);
   const Sparse symmetric = Sparse(B + Sparse(B.transpose()));
@@ -33,9 +33,12 @@ TEST(GalerkinProduct, MatchesTheSparseProduct) {
   Sparse P = random_sparse(400, 41, 12, rng);
   P.col(40) *= 0.0;
   P.prune(0.0);
-  for (const Sparse& A : {symmetric, diagonal}) {
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = P;
+  const std::array<Sparse, 2> products = detail::galerkin_products(symmetric, diagonal, P, rows);
+  for (int k = 0; k < 2; ++k) {
+    const Sparse& A = k == 0 ? symmetric : diagonal;
     const Eigen::MatrixXd expected = Eigen::MatrixXd(P.transpose() * A * P);
-    const Sparse C = detail::galerkin_product(A, P);
+    const Sparse& C = products[k];
     ASSERT_EQ(C.rows(), 41);
     ASSERT_EQ(C.cols(), 41);
     EXPECT_LT((Eigen::MatrixXd(C) - expected).cwiseAbs().maxCoeff(),

@@ -98,11 +98,15 @@ struct ManifoldHarmonicsPolicy {
   // The front ends' choice without a flag (default_eigensolver): multilevel from this many
   // vertices (docs/results.md, "Large meshes").
   int multilevel_from = 200000;
+  // From this many vertices, the solvers work in a breadth-first numbering of the vertices
+  // (linalg/locality_order.h; the basis comes back in the mesh's).
+  int reorder_from = 50000;
   // Several pieces (spectral/piecewise.h): each gets at least this many modes (or all its
   // vertices), with at most piece_modes_limit * m in all (beyond, the pieces of least area keep
-  // their constant only, or none: spectral/piecewise.h). A sphere of a 100-sphere assembly, pulled by 0.8 radii and turned by
-  // 0.6 rad: its base missed the handle by 0.41% of the diagonal with 10 modes, 0.11% with 16
-  // (the spherical harmonics of degree <= 3), 0.09% with 20 (tests/spectral/piecewise_test.cpp).
+  // their constant only, or none: spectral/piecewise.h). A sphere of a 100-sphere assembly, pulled
+  // by 0.8 radii and turned by 0.6 rad: its base missed the handle by 0.41% of the diagonal with 10
+  // modes, 0.11% with 16 (the spherical harmonics of degree <= 3), 0.09% with 20
+  // (tests/spectral/piecewise_test.cpp).
   int piece_min_modes = 16;
   int piece_modes_limit = 16;
 

@@ -1,0 +1,67 @@
+#include "linalg/locality_order.h"
+
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+namespace specdeform::detail {
+
+Permutation breadth_first_order(const Eigen::SparseMatrix<double>& A) {
+  const int n = static_cast<int>(A.rows());
+  Permutation P(n);
+  std::vector<int> order;
+  order.reserve(n);
+  std::vector<char> seen(n, 0);
+  for (int root = 0; root < n; ++root) {
+    if (seen[root]) continue;
+    seen[root] = 1;
+    order.push_back(root);
+    for (size_t head = order.size() - 1; head < order.size(); ++head) {  // order is the queue
+      for (Eigen::SparseMatrix<double>::InnerIterator it(A, order[head]); it; ++it) {
+        const int j = static_cast<int>(it.index());
+        if (!seen[j]) {
+          seen[j] = 1;
+          order.push_back(j);
+        }
+      }
+    }
+  }
+  for (int k = 0; k < n; ++k) P.indices()[order[k]] = k;
+  return P;
+}
+
+Eigen::SparseMatrix<double> renumbered(const Eigen::SparseMatrix<double>& A, const Permutation& P) {
+  const int n = static_cast<int>(A.cols());
+  const int* to = P.indices().data();
+  Eigen::SparseMatrix<double> B(A.rows(), n);
+  B.resizeNonZeros(A.nonZeros());
+  int* start = B.outerIndexPtr();
+  start[0] = 0;
+  for (int j = 0; j < n; ++j) start[to[j] + 1] = A.outerIndexPtr()[j + 1] - A.outerIndexPtr()[j];
+  for (int c = 0; c < n; ++c) start[c + 1] += start[c];
+  std::vector<std::pair<int, double>> column;
+  for (int j = 0; j < n; ++j) {
+    column.clear();
+    for (Eigen::SparseMatrix<double>::InnerIterator it(A, j); it; ++it)
+      column.emplace_back(to[it.index()], it.value());
+    std::sort(column.begin(), column.end());
+    int at = start[to[j]];
+    for (const auto& [row, value] : column) {
+      B.innerIndexPtr()[at] = row;
+      B.valuePtr()[at++] = value;
+    }
+  }
+  return B;
+}
+
+void permute_rows_back(const Permutation& P, Eigen::MatrixXd& X) {
+  Eigen::VectorXd column(X.rows());
+  const int* to = P.indices().data();
+  for (Eigen::Index j = 0; j < X.cols(); ++j) {
+    column = X.col(j);
+    double* x = X.col(j).data();
+    for (Eigen::Index i = 0; i < X.rows(); ++i) x[i] = column[to[i]];
+  }
+}
+
+}  // namespace specdeform::detail
