@@ -255,7 +255,7 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
     // Bending in the mixed form (deform/reduced_forms.h): a curvature M^-1 K s' taken as its
     // projection H S c' onto the span, s' = H c', S = H^T K H; the base's coefficients a from
     // the basis's own mass.
-    const Eigen::MatrixXd S = detail::reduced_stiffness(K, H);
+    const Eigen::MatrixXd S = detail::reduced_stiffness(K, *basis);
     const bool lumped = basis->mass == MassType::Lumped;
     const Sparse own_mass =
         lumped ? Sparse(mass.asDiagonal()) : mass_matrix(mesh, basis->mass, basis->laplacian);

@@ -27,6 +27,12 @@ Eigen::MatrixXd reduced_stiffness(const Eigen::SparseMatrix<double>& K, const Ei
   return 0.5 * (S + S.transpose());
 }
 
+Eigen::MatrixXd reduced_stiffness(const Eigen::SparseMatrix<double>& K,
+                                  const ManifoldHarmonics& basis) {
+  if (basis.rayleigh_ritz) return basis.eigenvalues.asDiagonal();
+  return reduced_stiffness(K, basis.basis);
+}
+
 Eigen::MatrixXd reduced_bending(const Eigen::MatrixXd& S, const Eigen::VectorXd& area,
                                 const Eigen::MatrixXd& U, bool orthonormal) {
   if (orthonormal) return S * S;

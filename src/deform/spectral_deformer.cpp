@@ -37,7 +37,7 @@ Eigen::MatrixXd linear_hessian(const TriangleMesh& mesh, const ManifoldHarmonics
                                const DeformOptions& options) {
   const LaplacianOperators L = laplacian_operators(mesh, MassType::Lumped, basis.laplacian);
   const Eigen::VectorXd area = L.mass.diagonal();
-  const Eigen::MatrixXd S = detail::reduced_stiffness(L.stiffness, basis.basis);
+  const Eigen::MatrixXd S = detail::reduced_stiffness(L.stiffness, basis);
   return options.ks * S +
          (options.kb * area.sum()) *
              detail::reduced_bending(S, area, basis.basis, basis.mass == MassType::Lumped);

@@ -9,7 +9,7 @@ namespace specdeform {
 
 VertexClusters vertex_clusters(const TriangleMesh& mesh, int count) {
   const int n = mesh.num_vertices();
-  // Edge lists per vertex (compressed rows; an edge listed once per face is harmless).
+  // Neighbour lists per vertex (compressed rows, each edge once per end).
   std::vector<int> start(n + 1, 0);
   for (int f = 0; f < mesh.num_faces(); ++f)
     for (int k = 0; k < 3; ++k) start[mesh.F(f, k) + 1] += 2;
@@ -23,10 +23,42 @@ VertexClusters vertex_clusters(const TriangleMesh& mesh, int count) {
       neighbour[fill[i]++] = mesh.F(f, (k + 2) % 3);
     }
   }
+  // Renumbered breadth first (neighbours close in memory: a subdivided mesh numbers them far
+  // apart), the lists deduplicated, with their edges' lengths.
+  std::vector<int> order, rank(n, -1);
+  order.reserve(n);
+  for (int root = 0; root < n; ++root) {
+    if (rank[root] >= 0) continue;
+    rank[root] = static_cast<int>(order.size());
+    order.push_back(root);
+    for (size_t head = order.size() - 1; head < order.size(); ++head) {
+      for (int e = start[order[head]]; e < start[order[head] + 1]; ++e) {
+        const int j = neighbour[e];
+        if (rank[j] < 0) {
+          rank[j] = static_cast<int>(order.size());
+          order.push_back(j);
+        }
+      }
+    }
+  }
+  std::vector<int> first(n + 1, 0), next;
+  std::vector<double> length;
+  next.reserve(neighbour.size());
+  length.reserve(neighbour.size());
+  for (int k = 0; k < n; ++k) {
+    const int v = order[k];
+    const size_t begin = next.size();
+    for (int e = start[v]; e < start[v + 1]; ++e) next.push_back(rank[neighbour[e]]);
+    std::sort(next.begin() + begin, next.end());
+    next.erase(std::unique(next.begin() + begin, next.end()), next.end());
+    for (size_t e = begin; e < next.size(); ++e)
+      length.push_back((mesh.V.row(v) - mesh.V.row(order[next[e]])).norm());
+    first[k + 1] = static_cast<int>(next.size());
+  }
 
   constexpr double kUnreached = std::numeric_limits<double>::infinity();
   VertexClusters out;
-  out.label = Eigen::VectorXi::Constant(n, -1);
+  Eigen::VectorXi label = Eigen::VectorXi::Constant(n, -1);  // in the new numbering
   std::vector<double> distance(n, kUnreached);
   using Entry = std::pair<double, int>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
@@ -34,18 +66,18 @@ VertexClusters vertex_clusters(const TriangleMesh& mesh, int count) {
   while (n > 0) {
     const int cluster = out.count++;
     distance[seed] = 0.0;
-    out.label[seed] = cluster;
+    label[seed] = cluster;
     queue.emplace(0.0, seed);
     while (!queue.empty()) {  // Dijkstra, only where this seed is nearer than earlier ones
       const auto [d, i] = queue.top();
       queue.pop();
       if (d > distance[i]) continue;
-      for (int e = start[i]; e < start[i + 1]; ++e) {
-        const int j = neighbour[e];
-        const double dj = d + (mesh.V.row(i) - mesh.V.row(j)).norm();
+      for (int e = first[i]; e < first[i + 1]; ++e) {
+        const int j = next[e];
+        const double dj = d + length[e];
         if (dj < distance[j]) {
           distance[j] = dj;
-          out.label[j] = cluster;
+          label[j] = cluster;
           queue.emplace(dj, j);
         }
       }
@@ -54,6 +86,8 @@ VertexClusters vertex_clusters(const TriangleMesh& mesh, int count) {
     const bool unreached = distance[seed] == kUnreached;
     if (out.count >= n || (out.count >= count && !unreached) || distance[seed] == 0.0) break;
   }
+  out.label.resize(n);
+  for (int k = 0; k < n; ++k) out.label[order[k]] = label[k];
   return out;
 }
 

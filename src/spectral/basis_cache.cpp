@@ -142,6 +142,7 @@ ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMe
     out.status = get<uint8_t>(r) == 1 ? SolveStatus::Converged : SolveStatus::NotConverged;
     out.cluster_truncated = get<uint8_t>(r) == 1;
     out.approximate = get<uint8_t>(r) == 1;
+    out.rayleigh_ritz = out.approximate;  // only the multilevel solver writes approximate bases
     out.coarse_functions = static_cast<int>(get<uint32_t>(r));
   } else {
     out.max_residual = std::numeric_limits<double>::quiet_NaN();  // not recorded

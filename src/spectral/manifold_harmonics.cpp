@@ -182,6 +182,7 @@ ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Spa
   out.status = s.status;
   out.cluster_truncated = s.cluster_truncated;
   out.approximate = multilevel;
+  out.rayleigh_ritz = multilevel;
   out.coarse_functions = s.coarse_functions;
   out.pieces = pieces;
   out.requested_modes = m;

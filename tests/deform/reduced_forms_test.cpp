@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/QR>
+
 #include "specdeform/mesh/generate.h"
 #include "specdeform/operators/cotan_laplacian.h"
 #include "specdeform/operators/mass_matrix.h"
@@ -40,6 +42,31 @@ TEST(ReducedForms, EigenvaluesForEigenvectorsProductsForAnyBasis) {
   const Eigen::MatrixXd bending = SU * G * SU;
   EXPECT_LT((detail::reduced_bending(SU, area, U, false) - bending).cwiseAbs().maxCoeff(),
             1e-12 * bending.cwiseAbs().maxCoeff());
+}
+
+// A multilevel basis is a Rayleigh-Ritz basis of K: its stiffness form is its eigenvalues, which
+// the basis's flag lets the deformer take as they are.
+TEST(ReducedForms, ARayleighRitzBasisHasItsEigenvaluesForStiffness) {
+  const TriangleMesh sphere = make_icosphere(5);
+  ManifoldHarmonicsOptions o;
+  o.num_modes = 20;
+  o.solver = EigenSolver::Multilevel;
+  o.policy.multilevel_min_samples = 400;
+  const ManifoldHarmonics h = compute_manifold_harmonics(sphere, o);
+  ASSERT_TRUE(h.approximate);
+  ASSERT_TRUE(h.rayleigh_ritz);
+  const Eigen::SparseMatrix<double> K = cotan_stiffness(sphere);
+  const Eigen::MatrixXd product = detail::reduced_stiffness(K, h.basis);
+  const Eigen::MatrixXd taken = detail::reduced_stiffness(K, h);
+  EXPECT_LT((taken - product).cwiseAbs().maxCoeff(), 1e-9 * h.eigenvalues.maxCoeff());
+  ManifoldHarmonics turned = h;
+  turned.rayleigh_ritz = false;
+  turned.basis =
+      h.basis *
+      Eigen::MatrixXd(
+          Eigen::HouseholderQR<Eigen::MatrixXd>(Eigen::MatrixXd::Random(20, 20)).householderQ());
+  EXPECT_GT((detail::reduced_stiffness(K, turned) - taken).cwiseAbs().maxCoeff(),
+            1e-3 * h.eigenvalues.maxCoeff());
 }
 
 }  // namespace

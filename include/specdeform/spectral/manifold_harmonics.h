@@ -151,6 +151,11 @@ struct ManifoldHarmonics {
   // eigenvectors; `status` is the coarse solve's and the residuals measure the approximation.
   bool approximate = false;
   int coarse_functions = 0;
+  // H^T K H = diag(eigenvalues) to rounding by construction: the pairs of a Rayleigh-Ritz on K
+  // (the multilevel solver's coarse problem), so a deformer takes its stiffness form from the
+  // eigenvalues (deform/reduced_forms.h). False for a basis made otherwise, which may be any
+  // M-orthonormal one.
+  bool rayleigh_ritz = false;
   // Connected pieces, solved one by one when more than one (0: not recorded, a basis file of
   // version 4 or older); the m asked for (the basis has more columns when pieces > 1).
   int pieces = 1;
