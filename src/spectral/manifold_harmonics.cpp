@@ -9,6 +9,7 @@
 
 #include "linalg/locality_order.h"
 #include "linalg/mass_operator.h"
+#include "linalg/parallel.h"
 #include "specdeform/exceptions.h"
 #include "spectral/coarse_space.h"
 #include "spectral/eigen_residual.h"
@@ -191,12 +192,15 @@ ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Spa
   out.solves = s.solves;
   out.eigenvalues = s.lambda / area;
   out.basis = std::move(s.H);
-  out.basis /= std::sqrt(area);
-  for (int j = 0; j < columns; ++j) {  // sign convention: largest-magnitude entry positive
-    Eigen::Index i;
-    out.basis.col(j).cwiseAbs().maxCoeff(&i);
-    if (out.basis(i, j) < 0) out.basis.col(j) *= -1.0;
-  }
+  // Unit area, and the sign convention: each column's largest-magnitude entry positive (the
+  // columns split between two threads: two passes over n x m).
+  detail::split_in_two(columns, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index j = begin; j < end; ++j) {
+      Eigen::Index i;
+      out.basis.col(j).cwiseAbs().maxCoeff(&i);
+      out.basis.col(j) *= (out.basis(i, j) < 0 ? -1.0 : 1.0) / std::sqrt(area);
+    }
+  });
   detail::report(o, 1.0, "verification");
   const detail::PairErrors errors = detail::pair_errors(K, M, out.basis, out.eigenvalues);
   out.residuals = errors.residual;
