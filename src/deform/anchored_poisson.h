@@ -1,8 +1,9 @@
 // Internal: the Poisson system of deformation transfer with its anchors, K_anchored x = b, K the
 // cotangent stiffness of the detailed mesh and the anchors' rows and columns made identity.
 //
-// A simplicial LDL^T factorisation (CHOLMOD) in a nested-dissection ordering (METIS): it keeps
-// neighbours close in memory and splits the work evenly between two threads. When the anchor
+// A simplicial LDL^T factorisation (CHOLMOD; computed supernodal, then converted) in a
+// nested-dissection ordering (METIS): it keeps neighbours close in memory and splits the work
+// evenly between two threads. When the anchor
 // set changes, newly anchored
 // vertices are removed with cholmod_rowdel and released ones put back with cholmod_rowadd (a
 // rank-2 update each), so a selection change costs in proportion to its difference; a change of
@@ -49,6 +50,7 @@ class AnchoredPoisson {
   std::vector<int> position_;  // vertex -> its row in the factor
   cholmod_common_struct* common_;
   cholmod_factor_struct* factor_ = nullptr;
+  cholmod_factor_struct* symbolic_ = nullptr;  // the supernodal analysis, copied per factorisation
   bool factored_ = false;
   TriangularSolver solver_;
 };

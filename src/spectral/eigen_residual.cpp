@@ -24,11 +24,14 @@ namespace {
 constexpr int kColumns = 16;
 using RowSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
-// Sums over the rows [begin, end) of d_i (K h - l M h)_i^2 and d_i (|K||h| + |l| |M||h|)_i^2 for
-// the kColumns columns of `block` (n x kColumns, row-major), added to residual2 and floor2.
-__attribute__((target_clones("avx2", "default"))) void block_sums(
-    const RowSparse& K, const RowSparse& M, const double* block, const double* l,
-    const double* d_inv, Eigen::Index begin, Eigen::Index end, double* residual2, double* floor2) {
+// Sums over the rows [begin, end) of d_i (K h - l M h)_i^2 and, with kFloors,
+// d_i (|K||h| + |l| |M||h|)_i^2 for the kColumns columns of `block` (n x kColumns, row-major),
+// added to residual2 and floor2.
+template <bool kFloors>
+[[gnu::always_inline]] inline void block_sums(const RowSparse& K, const RowSparse& M,
+                                              const double* block, const double* l,
+                                              const double* d_inv, Eigen::Index begin,
+                                              Eigen::Index end, double* residual2, double* floor2) {
   for (Eigen::Index i = begin; i < end; ++i) {
     double kh[kColumns] = {}, mh[kColumns] = {}, kh_abs[kColumns] = {}, mh_abs[kColumns] = {};
     for (int e = K.outerIndexPtr()[i]; e < K.outerIndexPtr()[i + 1]; ++e) {
@@ -36,7 +39,7 @@ __attribute__((target_clones("avx2", "default"))) void block_sums(
       const double* h = block + kColumns * K.innerIndexPtr()[e];
       for (int q = 0; q < kColumns; ++q) {
         kh[q] += v * h[q];
-        kh_abs[q] += a * std::abs(h[q]);
+        if constexpr (kFloors) kh_abs[q] += a * std::abs(h[q]);
       }
     }
     for (int e = M.outerIndexPtr()[i]; e < M.outerIndexPtr()[i + 1]; ++e) {
@@ -44,22 +47,40 @@ __attribute__((target_clones("avx2", "default"))) void block_sums(
       const double* h = block + kColumns * M.innerIndexPtr()[e];
       for (int q = 0; q < kColumns; ++q) {
         mh[q] += v * h[q];
-        mh_abs[q] += a * std::abs(h[q]);
+        if constexpr (kFloors) mh_abs[q] += a * std::abs(h[q]);
       }
     }
     for (int q = 0; q < kColumns; ++q) {
-      const double r = kh[q] - l[q] * mh[q], f = kh_abs[q] + std::abs(l[q]) * mh_abs[q];
+      const double r = kh[q] - l[q] * mh[q];
       residual2[q] += d_inv[i] * r * r;
-      floor2[q] += d_inv[i] * f * f;
+      if constexpr (kFloors) {
+        const double f = kh_abs[q] + std::abs(l[q]) * mh_abs[q];
+        floor2[q] += d_inv[i] * f * f;
+      }
     }
   }
+}
+
+__attribute__((target_clones("avx2", "default"))) void sums_with_floors(
+    const RowSparse& K, const RowSparse& M, const double* block, const double* l,
+    const double* d_inv, Eigen::Index begin, Eigen::Index end, double* residual2, double* floor2) {
+  block_sums<true>(K, M, block, l, d_inv, begin, end, residual2, floor2);
+}
+
+__attribute__((target_clones("avx2", "default"))) void sums(const RowSparse& K, const RowSparse& M,
+                                                            const double* block, const double* l,
+                                                            const double* d_inv, Eigen::Index begin,
+                                                            Eigen::Index end, double* residual2,
+                                                            double* floor2) {
+  block_sums<false>(K, M, block, l, d_inv, begin, end, residual2, floor2);
 }
 
 }  // namespace
 
 // In blocks of kColumns pairs, each copied row-major, rows split between two threads: per row
 // of K (CSR) one pass over its entries serves all the block's residuals and floors.
-PairErrors pair_errors(const Sparse& K, const Sparse& M, const Mat& H, const Vec& lambda) {
+PairErrors pair_errors(const Sparse& K, const Sparse& M, const Mat& H, const Vec& lambda,
+                       bool floors) {
   using Block = Eigen::Matrix<double, Eigen::Dynamic, kColumns, Eigen::RowMajor>;
   using Sums = Eigen::Array<double, kColumns, 1>;
   const RowSparse Kr = K, Mr = M;
@@ -77,8 +98,8 @@ PairErrors pair_errors(const Sparse& K, const Sparse& M, const Mat& H, const Vec
     Sums residual2[2] = {Sums::Zero(), Sums::Zero()}, floor2[2] = {Sums::Zero(), Sums::Zero()};
     split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
       const int t = begin == 0 ? 0 : 1;
-      block_sums(Kr, Mr, block.data(), l.data(), d_inv.data(), begin, end, residual2[t].data(),
-                 floor2[t].data());
+      (floors ? sums_with_floors : sums)(Kr, Mr, block.data(), l.data(), d_inv.data(), begin, end,
+                                         residual2[t].data(), floor2[t].data());
     });
     for (Eigen::Index p = 0; p < c; ++p) {
       const double scale = area / std::max(area * lambda[j + p], 1.0);

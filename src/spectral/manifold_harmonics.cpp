@@ -202,7 +202,8 @@ ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Spa
     }
   });
   detail::report(o, 1.0, "verification");
-  const detail::PairErrors errors = detail::pair_errors(K, M, out.basis, out.eigenvalues);
+  const detail::PairErrors errors =
+      detail::pair_errors(K, M, out.basis, out.eigenvalues, !multilevel);
   out.residuals = errors.residual;
   out.max_residual = errors.residual.maxCoeff();
   out.rounding_floor = errors.floor.maxCoeff();

@@ -144,6 +144,7 @@ struct ManifoldHarmonics {
   Eigen::VectorXd residuals;             // per pair, as `tolerance` defines it
   double max_residual = 0.0;             // their max
   double rounding_floor = 0.0;           // max over pairs of the rounding error of K h - l M h
+                                         // (0 for an approximate basis: not computed)
   double threshold = 0.0;                // max over pairs of the threshold applied
   double max_orthogonality_error = 0.0;  // max |H^T M H - I|
   bool cluster_truncated = false;        // lambda_m is (nearly) equal to lambda_{m+1}
