@@ -4,6 +4,8 @@
 #include <utility>
 #include <vector>
 
+#include "linalg/parallel.h"
+
 namespace specdeform::detail {
 
 Permutation breadth_first_order(const Eigen::SparseMatrix<double>& A) {
@@ -55,13 +57,15 @@ Eigen::SparseMatrix<double> renumbered(const Eigen::SparseMatrix<double>& A, con
 }
 
 void permute_rows_back(const Permutation& P, Eigen::MatrixXd& X) {
-  Eigen::VectorXd column(X.rows());
   const int* to = P.indices().data();
-  for (Eigen::Index j = 0; j < X.cols(); ++j) {
-    column = X.col(j);
-    double* x = X.col(j).data();
-    for (Eigen::Index i = 0; i < X.rows(); ++i) x[i] = column[to[i]];
-  }
+  split_in_two(X.cols(), [&](Eigen::Index begin, Eigen::Index end) {
+    Eigen::VectorXd column(X.rows());
+    for (Eigen::Index j = begin; j < end; ++j) {
+      column = X.col(j);
+      double* x = X.col(j).data();
+      for (Eigen::Index i = 0; i < X.rows(); ++i) x[i] = column[to[i]];
+    }
+  });
 }
 
 }  // namespace specdeform::detail

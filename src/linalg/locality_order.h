@@ -21,7 +21,7 @@ Permutation breadth_first_order(const Eigen::SparseMatrix<double>& A);
 Eigen::SparseMatrix<double> renumbered(const Eigen::SparseMatrix<double>& A, const Permutation& P);
 
 // X.row(i) = X.row(P.indices()[i]) for every i, column by column with one column of scratch
-// (P.transpose() * X would need a second n x m matrix).
+// per thread (P.transpose() * X would need a second n x m matrix); two threads.
 void permute_rows_back(const Permutation& P, Eigen::MatrixXd& X);
 
 }  // namespace specdeform::detail

@@ -29,7 +29,10 @@ std::string join_continued_lines(std::string_view data) {
 }  // namespace
 
 PolygonSoup parse_obj(std::string_view raw, const std::string& name) {
-  const std::string data = join_continued_lines(raw);
+  const std::string joined = raw.find('\\') == std::string_view::npos
+                                 ? std::string()
+                                 : join_continued_lines(raw);  // most files have none
+  const std::string_view data = joined.empty() ? raw : joined;
   TextScanner in(data, name);
   PolygonSoup soup;
   std::vector<int> corners;

@@ -132,8 +132,12 @@ ManifoldHarmonics harmonics(const Sparse& K, const Sparse& M, const Sparse* leng
   }
   if (K.rows() < o.policy.reorder_from) return harmonics_in_order(K, M, lengths, o);
   const auto P = detail::breadth_first_order(K);
-  const Sparse K_ordered = detail::renumbered(K, P), M_ordered = detail::renumbered(M, P);
-  const Sparse lengths_ordered = lengths ? detail::renumbered(*lengths, P) : Sparse();
+  Sparse K_ordered, M_ordered, lengths_ordered;
+  detail::run_pair([&] { K_ordered = detail::renumbered(K, P); },
+                   [&] {
+                     M_ordered = detail::renumbered(M, P);
+                     if (lengths) lengths_ordered = detail::renumbered(*lengths, P);
+                   });
   ManifoldHarmonics h =
       harmonics_in_order(K_ordered, M_ordered, lengths ? &lengths_ordered : nullptr, o);
   detail::permute_rows_back(P, h.basis);
