@@ -47,18 +47,20 @@ AnchoredPoisson::~AnchoredPoisson() {
 }
 
 void AnchoredPoisson::factorize() {
-  Sparse A = K_;
-  for (int col = 0; col < A.outerSize(); ++col) {
-    for (Sparse::InnerIterator it(A, col); it; ++it) {
-      if (anchored_[col] || anchored_[it.row()]) it.valueRef() = it.row() == col ? 1.0 : 0.0;
-    }
-  }
-  Sparse lower = A.triangularView<Eigen::Lower>();
-  cholmod_sparse view = Eigen::viewAsCholmod(lower);
-  view.stype = -1;
   cholmod_free_factor(&factor_, common_);
   factor_ = cholmod_copy_factor(symbolic_, common_);
-  cholmod_factorize(&view, factor_, common_);
+  {  // K's lower triangle, the anchors' rows and columns made identity; gone before the
+     // conversion below, which holds both forms of the factor for a moment
+    Sparse lower = K_.triangularView<Eigen::Lower>();
+    for (int col = 0; col < lower.outerSize(); ++col) {
+      for (Sparse::InnerIterator it(lower, col); it; ++it) {
+        if (anchored_[col] || anchored_[it.row()]) it.valueRef() = it.row() == col ? 1.0 : 0.0;
+      }
+    }
+    cholmod_sparse view = Eigen::viewAsCholmod(lower);
+    view.stype = -1;
+    cholmod_factorize(&view, factor_, common_);
+  }
   if (common_->status != CHOLMOD_OK || factor_->minor < factor_->n) {
     throw SolverError("deformation transfer: the Poisson system is singular");
   }
