@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <exception>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -11,6 +12,7 @@
 #include "deform/reduced_forms.h"
 #include "linalg/basis_product.h"
 #include "linalg/nearest_rotation.h"
+#include "linalg/parallel.h"
 #include "membrane_stiffness.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/vertex_clusters.h"
@@ -211,19 +213,37 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
     throw InputError("ARAP: the base has " + std::to_string(base.rows()) + " vertices, the mesh " +
                      std::to_string(mesh.num_vertices()));
   }
-  const VertexClusters clusters = vertex_clusters(TriangleMesh{base, mesh.F}, options.clusters);
-  label_ = clusters.label;
-  // The basis's own Laplacian and lumped mass.
+  // The clusters beside the basis's own Laplacian and lumped mass (two threads: 0.8 and 0.5 s at
+  // 692k vertices).
+  VertexClusters clusters;
   Sparse K;
   Eigen::VectorXd mass;
-  if (basis) {
-    LaplacianOperators L = laplacian_operators(mesh, MassType::Lumped, basis->laplacian);
-    K = std::move(L.stiffness);
-    mass = L.mass.diagonal();
-  } else {
-    K = cotan_stiffness(mesh);
-    mass = lumped_mass(mesh);
-  }
+  std::exception_ptr failed[2];
+  detail::run_pair(
+      [&] {
+        try {
+          clusters = vertex_clusters(TriangleMesh{base, mesh.F}, options.clusters);
+        } catch (...) {
+          failed[0] = std::current_exception();
+        }
+      },
+      [&] {
+        try {
+          if (basis) {
+            LaplacianOperators L = laplacian_operators(mesh, MassType::Lumped, basis->laplacian);
+            K = std::move(L.stiffness);
+            mass = L.mass.diagonal();
+          } else {
+            K = cotan_stiffness(mesh);
+            mass = lumped_mass(mesh);
+          }
+        } catch (...) {
+          failed[1] = std::current_exception();
+        }
+      });
+  for (const std::exception_ptr& e : failed)
+    if (e) std::rethrow_exception(e);
+  label_ = clusters.label;
   // Membrane and bending, as the linear energy's ks = 1 and kb = bending (unit-area scale).
   const Sparse stretch =
       cluster_operator(detail::membrane_stiffness(K), base, label_, clusters.count);

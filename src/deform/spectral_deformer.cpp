@@ -67,7 +67,9 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
   Clock clock;
   components_ = vertex_components(mesh_, &num_components_);
   piece_modes_.assign(num_components_, 0);
-  if (has_basis) {
+  if (has_basis && num_components_ == 1) {
+    piece_modes_[0] = static_cast<int>(basis_->basis.cols());
+  } else if (has_basis) {
     // A mode's piece: the piece of its largest entry (a basis of several pieces is computed
     // piece by piece, each mode on one).
     for (Eigen::Index j = 0; j < basis_->basis.cols(); ++j) {
