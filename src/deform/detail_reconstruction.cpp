@@ -161,17 +161,19 @@ struct DetailReconstruction::Poisson {
 // newest is factored).
 struct DetailReconstruction::Background {
   void run(Poisson& poisson, TriangleMesh mesh, Vertices base) {
+    bool built = true;  // else `error` says why, for good
     try {
       poisson.build(mesh, base);
     } catch (...) {
       std::lock_guard lock(mutex);
       error = std::current_exception();
+      built = false;
     }
     mesh = {};
     base.resize(0, 3);
     std::unique_lock lock(mutex);
     while (true) {
-      wake.wait(lock, [&] { return stop || (pending && !error); });
+      wake.wait(lock, [&] { return stop || (built && pending); });
       if (stop) return;
       const std::vector<int> anchors = std::move(*pending);
       pending.reset();
@@ -184,7 +186,7 @@ struct DetailReconstruction::Background {
         failed = std::current_exception();
       }
       lock.lock();
-      error = failed;
+      error = failed;  // the last anchor set's (a singular system), cleared by the next
       if (version == requested) {
         done = version;
         if (on_ready && !error) on_ready();

@@ -135,7 +135,7 @@ CoarseSpace partition_of_unity(const Sparse& lengths, int samples, double suppor
   };
   run_pair([&] { bumps(0, N / 2); }, [&] { bumps(N / 2, N); });
   // Row-major by counting (each row's entries in column order), each entry divided by its
-  // row's sum (the partition of unity); then the column-major copy the same way.
+  // row's sum (the partition of unity).
   Eigen::SparseMatrix<double, Eigen::RowMajor>& R = out.rows;
   R.resize(n, N);
   std::vector<int> fill(n + 1, 0);
@@ -153,8 +153,7 @@ CoarseSpace partition_of_unity(const Sparse& lengths, int samples, double suppor
     columns[j] = {};
   }
   for (int i = 0; i < n; ++i) {
-    const auto row = R.row(i);
-    const double sum = row.sum();
+    const double sum = R.row(i).sum();
     for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(R, i); it; ++it) {
       it.valueRef() /= sum;
     }
