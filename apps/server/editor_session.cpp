@@ -123,6 +123,8 @@ struct EditorSession::State {
   std::optional<SpectralDeformer> sketch;
   double selection_seconds = 0.0, pin_error = 0.0;
   double influence = 0.0;  // the region of influence, of the diagonal (0: none)
+  // The last full frame sent added displacements while the transfer's factorisation ran.
+  bool shown_displacements = false;
 
   const Vertices& rest() const { return poses[pose].rest; }
   // What the deformers solve for the edit's selection: the surface beyond the region of
@@ -284,7 +286,7 @@ void EditorSession::text_message(std::string_view message) {
     const std::string format = j.value("format", "obj");
     const std::filesystem::path out =
         std::filesystem::path(s.name).stem().string() + "-deformed." + format;
-    const TriangleMesh file_order = to_file_order(s.loaded.info, result(), s.loaded.mesh.F);
+    const TriangleMesh file_order = to_file_order(s.loaded.info, result(true), s.loaded.mesh.F);
     return send_(true,
                  encode_file({out.string(), encode_mesh(file_order, mesh_format_from_path(out))}));
   }
@@ -468,7 +470,7 @@ void EditorSession::restore(size_t entry) {
 void EditorSession::apply_pose() {
   State& s = *state_;
   if (!s.has_handles) throw InputError("apply pose: nothing is moved yet (drag a handle first)");
-  const TriangleMesh posed{result(), s.loaded.mesh.F};
+  const TriangleMesh posed{result(true), s.loaded.mesh.F};
   PreparedBasis basis;
   const Clock::time_point start = Clock::now();
   auto reused = std::make_shared<ManifoldHarmonics>(reuse_basis(posed, *s.basis().harmonics));
@@ -685,7 +687,7 @@ void EditorSession::detail_ready() {
   State& s = *state_;
   if (!s.has_handles || s.deformer->detail_pending()) return;  // a newer selection factors
   request_ = "detail";
-  if (s.deformer->applied_detail() != s.options.detail) solve_and_send();
+  if (s.shown_displacements) solve_and_send();
   send_state();
 }
 
@@ -699,8 +701,12 @@ void EditorSession::sync_sketch() {
   if (s.has_handles) s.sketch->set_selection(s.solved(s.edit.selection));
 }
 
-const Vertices& EditorSession::result() {
+const Vertices& EditorSession::result(bool final) {
   State& s = *state_;
+  if (final && s.has_handles) {  // with the transfer's details, not the displacements meanwhile
+    s.deformer->wait_for_detail();
+    if (s.deformer->applied_detail() != s.options.detail) s.result_stale = true;
+  }
   if (s.result_stale) s.result = s.deformer->solve(s.edit.transforms);
   s.result_stale = false;
   return s.result;
@@ -721,6 +727,7 @@ void EditorSession::solve_and_send(bool preview) {
   } else {
     s.result = std::move(shown);
     s.result_stale = false;
+    s.shown_displacements = deformer.applied_detail() != s.options.detail;
   }
   const FrameTimings& t = deformer.frame_timings();
   const ConstraintError e = deformer.constraint_error(view.preview ? shown : s.result);

@@ -134,8 +134,10 @@ class EditorSession {
   void open_scene(const NamedFile& file);
   // `preview`: solved without details and sent at the preview's vertices only.
   void solve_and_send(bool preview = false);
-  void sync_sketch();        // the previews' deformer after the deformer changed
-  const Vertices& result();  // the detailed result of the current transforms
+  void sync_sketch();  // the previews' deformer after the deformer changed
+  // The detailed result of the current transforms, as shown; `final`: with the transfer's
+  // details (waits for its background factorisation; exports and poses).
+  const Vertices& result(bool final = false);
   void send_mesh();
   void send_ready();
   void send_selection();

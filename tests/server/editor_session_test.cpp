@@ -206,6 +206,10 @@ TEST(EditorSessionBackground, TheTransfersFrameFollowsItsFactorisation) {
     session->handle(true, encode_selection(plain(selection), Tag::Selection));
     session->handle(true, encode_frame({1, {turn}}));
   }
+  // An export does not wait for the message: it is the transfer's result at once.
+  sessions[1]->handle(false, R"({"type": "export_mesh", "format": "obj"})");
+  const NamedFile obj = decode_file(sent[1].back().data);
+  const Vertices exported = read_mesh_from_memory(obj.data, MeshFormat::Obj, obj.name).mesh.V;
   {
     std::unique_lock lock(mutex);
     ASSERT_TRUE(posted.wait_for(lock, std::chrono::seconds(30), [&] { return !jobs.empty(); }));
@@ -229,6 +233,7 @@ TEST(EditorSessionBackground, TheTransfersFrameFollowsItsFactorisation) {
   const Vertices expected = decode_frame_positions(last(0, true), rest);
   const Vertices shown = decode_frame_positions(last(1, true), rest);
   EXPECT_LT((shown - expected).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_LT((exported - expected).cwiseAbs().maxCoeff(), 1e-5);  // frames: 16 bits a coordinate
   EXPECT_FALSE(Json::parse(last(1, false))["detail_pending"]);
   EXPECT_FALSE(Json::parse(last(0, false))["detail_pending"]);
 }
