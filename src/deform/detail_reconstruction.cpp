@@ -14,6 +14,7 @@
 #include "anchored_poisson.h"
 #include "linalg/nearest_rotation.h"
 #include "linalg/parallel.h"
+#include "mesh/vertex_rings.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/operators/cotan_laplacian.h"
 #include "specdeform/operators/mass_matrix.h"
@@ -274,22 +275,16 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
       // Each vertex's one-ring, except where the base's one-ring collapsed (as for the
       // transfer's triangles): there the offset stays a plain displacement.
       const int n = detailed.num_vertices();
-      std::vector<std::vector<int>> rings(n);
-      for (int f = 0; f < detailed.num_faces(); ++f) {
-        for (int k = 0; k < 3; ++k) {
-          rings[faces_(f, k)].push_back(faces_(f, (k + 1) % 3));
-          rings[faces_(f, k)].push_back(faces_(f, (k + 2) % 3));
-        }
-      }
+      const detail::VertexRings rings = detail::vertex_rings(detailed);
       const Eigen::VectorXd area = lumped_mass(detailed);
       const Eigen::VectorXd base_area = lumped_mass(TriangleMesh{base, faces_});
       ring_start_.assign(n + 1, 0);
       for (int i = 0; i < n; ++i) {
-        std::sort(rings[i].begin(), rings[i].end());
-        rings[i].erase(std::unique(rings[i].begin(), rings[i].end()), rings[i].end());
-        if (!(base_area[i] > kMinRelativeSize * kMinRelativeSize * area[i])) rings[i].clear();
-        ring_start_[i + 1] = ring_start_[i] + static_cast<int>(rings[i].size());
-        ring_.insert(ring_.end(), rings[i].begin(), rings[i].end());
+        if (base_area[i] > kMinRelativeSize * kMinRelativeSize * area[i]) {
+          ring_.insert(ring_.end(), rings.neighbour.begin() + rings.start[i],
+                       rings.neighbour.begin() + rings.start[i + 1]);
+        }
+        ring_start_[i + 1] = static_cast<int>(ring_.size());
       }
       base_ = base;
       base_normals_ = vertex_normals(TriangleMesh{base, faces_});

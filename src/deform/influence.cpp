@@ -7,19 +7,14 @@
 #include <string>
 #include <vector>
 
+#include "mesh/vertex_rings.h"
 #include "specdeform/exceptions.h"
 
 namespace specdeform {
 
 Eigen::VectorXd handle_distances(const TriangleMesh& mesh, const Selection& selection) {
   const int n = mesh.num_vertices();
-  std::vector<std::vector<int>> neighbours(n);
-  for (int f = 0; f < mesh.num_faces(); ++f) {
-    for (int k = 0; k < 3; ++k) {
-      neighbours[mesh.F(f, k)].push_back(mesh.F(f, (k + 1) % 3));
-      neighbours[mesh.F(f, (k + 1) % 3)].push_back(mesh.F(f, k));
-    }
-  }
+  const detail::VertexRings rings = detail::vertex_rings(mesh);
   Eigen::VectorXd distance = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
   using Entry = std::pair<double, int>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
@@ -36,7 +31,8 @@ Eigen::VectorXd handle_distances(const TriangleMesh& mesh, const Selection& sele
     const auto [d, v] = queue.top();
     queue.pop();
     if (d > distance[v]) continue;
-    for (const int w : neighbours[v]) {
+    for (int e = rings.start[v]; e < rings.start[v + 1]; ++e) {
+      const int w = rings.neighbour[e];
       const double through = d + (mesh.V.row(w) - mesh.V.row(v)).norm();
       if (through < distance[w]) {
         distance[w] = through;

@@ -9,7 +9,15 @@
 namespace specdeform::detail {
 
 Permutation breadth_first_order(const Eigen::SparseMatrix<double>& A) {
-  const int n = static_cast<int>(A.rows());
+  if (!A.isCompressed()) {
+    Eigen::SparseMatrix<double> B = A;
+    B.makeCompressed();
+    return breadth_first_order(B);
+  }
+  return breadth_first_order(static_cast<int>(A.rows()), A.outerIndexPtr(), A.innerIndexPtr());
+}
+
+Permutation breadth_first_order(int n, const int* start, const int* neighbour) {
   Permutation P(n);
   std::vector<int> order;
   order.reserve(n);
@@ -19,8 +27,8 @@ Permutation breadth_first_order(const Eigen::SparseMatrix<double>& A) {
     seen[root] = 1;
     order.push_back(root);
     for (size_t head = order.size() - 1; head < order.size(); ++head) {  // order is the queue
-      for (Eigen::SparseMatrix<double>::InnerIterator it(A, order[head]); it; ++it) {
-        const int j = static_cast<int>(it.index());
+      for (int e = start[order[head]]; e < start[order[head] + 1]; ++e) {
+        const int j = neighbour[e];
         if (!seen[j]) {
           seen[j] = 1;
           order.push_back(j);

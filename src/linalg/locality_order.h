@@ -15,6 +15,9 @@ using Permutation = Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int
 // first, each connected component in turn from its lowest-numbered vertex; A is n x n with a
 // symmetric pattern.
 Permutation breadth_first_order(const Eigen::SparseMatrix<double>& A);
+// The same for a graph given as compressed rows: vertex i's neighbours are
+// neighbour[start[i] .. start[i + 1]), i < n.
+Permutation breadth_first_order(int n, const int* start, const int* neighbour);
 
 // P A P^T: entry (i, j) of A at (P[i], P[j]), compressed, each column's rows sorted (Eigen's
 // own permuted product took ten times as long: 0.3 s for a 692k-vertex Laplacian).

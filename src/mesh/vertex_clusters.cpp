@@ -5,54 +5,31 @@
 #include <queue>
 #include <vector>
 
+#include "linalg/locality_order.h"
+#include "mesh/vertex_rings.h"
+
 namespace specdeform {
 
 VertexClusters vertex_clusters(const TriangleMesh& mesh, int count) {
   const int n = mesh.num_vertices();
-  // Neighbour lists per vertex (compressed rows, each edge once per end).
-  std::vector<int> start(n + 1, 0);
-  for (int f = 0; f < mesh.num_faces(); ++f)
-    for (int k = 0; k < 3; ++k) start[mesh.F(f, k) + 1] += 2;
-  for (int i = 0; i < n; ++i) start[i + 1] += start[i];
-  std::vector<int> neighbour(start[n]);
-  std::vector<int> fill(start.begin(), start.end() - 1);
-  for (int f = 0; f < mesh.num_faces(); ++f) {
-    for (int k = 0; k < 3; ++k) {
-      const int i = mesh.F(f, k);
-      neighbour[fill[i]++] = mesh.F(f, (k + 1) % 3);
-      neighbour[fill[i]++] = mesh.F(f, (k + 2) % 3);
-    }
-  }
-  // Renumbered breadth first (neighbours close in memory: a subdivided mesh numbers them far
-  // apart), the lists deduplicated, with their edges' lengths.
-  std::vector<int> order, rank(n, -1);
-  order.reserve(n);
-  for (int root = 0; root < n; ++root) {
-    if (rank[root] >= 0) continue;
-    rank[root] = static_cast<int>(order.size());
-    order.push_back(root);
-    for (size_t head = order.size() - 1; head < order.size(); ++head) {
-      for (int e = start[order[head]]; e < start[order[head] + 1]; ++e) {
-        const int j = neighbour[e];
-        if (rank[j] < 0) {
-          rank[j] = static_cast<int>(order.size());
-          order.push_back(j);
-        }
-      }
-    }
-  }
+  // The edge graph renumbered breadth first (neighbours close in memory: a subdivided mesh
+  // numbers them far apart), with its edges' lengths.
+  const detail::VertexRings rings = detail::vertex_rings(mesh);
+  const detail::Permutation P =
+      detail::breadth_first_order(n, rings.start.data(), rings.neighbour.data());
+  const int* rank = P.indices().data();
+  std::vector<int> order(n);
+  for (int i = 0; i < n; ++i) order[rank[i]] = i;
   std::vector<int> first(n + 1, 0), next;
   std::vector<double> length;
-  next.reserve(neighbour.size());
-  length.reserve(neighbour.size());
+  next.reserve(rings.neighbour.size());
+  length.reserve(rings.neighbour.size());
   for (int k = 0; k < n; ++k) {
     const int v = order[k];
-    const size_t begin = next.size();
-    for (int e = start[v]; e < start[v + 1]; ++e) next.push_back(rank[neighbour[e]]);
-    std::sort(next.begin() + begin, next.end());
-    next.erase(std::unique(next.begin() + begin, next.end()), next.end());
-    for (size_t e = begin; e < next.size(); ++e)
-      length.push_back((mesh.V.row(v) - mesh.V.row(order[next[e]])).norm());
+    for (int e = rings.start[v]; e < rings.start[v + 1]; ++e) {
+      next.push_back(rank[rings.neighbour[e]]);
+      length.push_back((mesh.V.row(v) - mesh.V.row(rings.neighbour[e])).norm());
+    }
     first[k + 1] = static_cast<int>(next.size());
   }
 
