@@ -32,24 +32,21 @@ template <bool kFloors>
                                               const double* block, const double* l,
                                               const double* d_inv, Eigen::Index begin,
                                               Eigen::Index end, double* residual2, double* floor2) {
+  // Row i of A times the block into ah, and of |A| times |block| into ah_abs (kFloors).
+  const auto row_product = [block](const RowSparse& A, Eigen::Index i, double* ah, double* ah_abs) {
+    for (int e = A.outerIndexPtr()[i]; e < A.outerIndexPtr()[i + 1]; ++e) {
+      const double v = A.valuePtr()[e], a = std::abs(v);
+      const double* h = block + kColumns * A.innerIndexPtr()[e];
+      for (int q = 0; q < kColumns; ++q) {
+        ah[q] += v * h[q];
+        if constexpr (kFloors) ah_abs[q] += a * std::abs(h[q]);
+      }
+    }
+  };
   for (Eigen::Index i = begin; i < end; ++i) {
     double kh[kColumns] = {}, mh[kColumns] = {}, kh_abs[kColumns] = {}, mh_abs[kColumns] = {};
-    for (int e = K.outerIndexPtr()[i]; e < K.outerIndexPtr()[i + 1]; ++e) {
-      const double v = K.valuePtr()[e], a = std::abs(v);
-      const double* h = block + kColumns * K.innerIndexPtr()[e];
-      for (int q = 0; q < kColumns; ++q) {
-        kh[q] += v * h[q];
-        if constexpr (kFloors) kh_abs[q] += a * std::abs(h[q]);
-      }
-    }
-    for (int e = M.outerIndexPtr()[i]; e < M.outerIndexPtr()[i + 1]; ++e) {
-      const double v = M.valuePtr()[e], a = std::abs(v);
-      const double* h = block + kColumns * M.innerIndexPtr()[e];
-      for (int q = 0; q < kColumns; ++q) {
-        mh[q] += v * h[q];
-        if constexpr (kFloors) mh_abs[q] += a * std::abs(h[q]);
-      }
-    }
+    row_product(K, i, kh, kh_abs);
+    row_product(M, i, mh, mh_abs);
     for (int q = 0; q < kColumns; ++q) {
       const double r = kh[q] - l[q] * mh[q];
       residual2[q] += d_inv[i] * r * r;
