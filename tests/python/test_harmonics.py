@@ -245,7 +245,9 @@ def test_the_gil_is_released_while_the_basis_is_computed(bar):
     while worker.is_alive():
         counter[0] += 1
         time.sleep(0)
-    assert seen[-1] - seen[0] > 1000
+    # With the GIL held it could count only while a progress callback runs: a handful. 1000 failed
+    # once in CI (968) on a loaded machine once the basis got faster.
+    assert seen[-1] - seen[0] > 100
 
 
 def test_cholmod_prints_nothing(capfd, bar):
