@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "specdeform/mesh/generate.h"
@@ -28,6 +29,38 @@ TEST(CotanStiffness, SymmetricPositiveSemidefiniteWithConstantKernel) {
     }
     for (int k = 0; k < K.outerSize(); ++k)
       for (Sparse::InnerIterator it(K, k); it; ++it) EXPECT_TRUE(std::isfinite(it.value()));
+  }
+}
+
+// The assembly by counting against the textbook one (four triplets per corner of each sound face):
+// the same entries, explicit zeros of right angles included, no entry from a degenerate face and
+// none for a vertex without a sound face.
+TEST(CotanStiffness, EqualsTheTripletAssembly) {
+  for (const auto& c : test::corpus()) {
+    const TriangleMesh& mesh = c.mesh;
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (int f = 0; f < mesh.num_faces(); ++f) {
+      const Eigen::Vector3d p[3] = {mesh.V.row(mesh.F(f, 0)), mesh.V.row(mesh.F(f, 1)),
+                                    mesh.V.row(mesh.F(f, 2))};
+      if (is_degenerate_triangle(p[0], p[1], p[2])) continue;
+      const double double_area = (p[1] - p[0]).cross(p[2] - p[0]).norm();
+      for (int k = 0; k < 3; ++k) {
+        const int i = mesh.F(f, (k + 1) % 3), j = mesh.F(f, (k + 2) % 3);
+        const double w = 0.5 * (p[(k + 1) % 3] - p[k]).dot(p[(k + 2) % 3] - p[k]) / double_area;
+        triplets.insert(triplets.end(), {{i, j, -w}, {j, i, -w}, {i, i, w}, {j, j, w}});
+      }
+    }
+    Sparse expected(mesh.num_vertices(), mesh.num_vertices());
+    expected.setFromTriplets(triplets.begin(), triplets.end());
+    const Sparse K = cotan_stiffness(mesh);
+    ASSERT_EQ(K.nonZeros(), expected.nonZeros()) << c.name;
+    EXPECT_TRUE(
+        std::equal(K.outerIndexPtr(), K.outerIndexPtr() + K.cols() + 1, expected.outerIndexPtr()))
+        << c.name;
+    EXPECT_TRUE(
+        std::equal(K.innerIndexPtr(), K.innerIndexPtr() + K.nonZeros(), expected.innerIndexPtr()))
+        << c.name;
+    EXPECT_EQ(Sparse(K - expected).norm(), 0.0) << c.name;
   }
 }
 
