@@ -45,6 +45,7 @@ void add_deform_command(CLI::App& app) {
     const Selection& selection = loaded_scene.selection;
     DeformOptions options = args->deform.merged(*cmd, scene.options);
     options.float32_basis = args->deform.options.float32_basis;
+    options.single_solve = args->repeat == 1;  // the basis released before the details
     options.validate();
     int modes = args->modes;
     if (cmd->count("--modes") == 0 && scene.modes) modes = *scene.modes;
@@ -68,6 +69,7 @@ void add_deform_command(CLI::App& app) {
     } else {
       timings["basis"] = 0.0;
     }
+    const bool approximate = basis && basis->approximate;
     SpectralDeformer deformer(loaded.mesh, std::move(basis), options);
     deformer.set_selection(selection);
     Vertices result;
@@ -89,7 +91,7 @@ void add_deform_command(CLI::App& app) {
       j["vertices"] = loaded.mesh.num_vertices();
       j["modes"] = options.solver == DeformSolver::Spectral ? modes : 0;
       j["basis_cached"] = loaded_basis;
-      j["basis_approximate"] = deformer.basis() && deformer.basis()->approximate;
+      j["basis_approximate"] = approximate;
       j["constrained_vertices"] = constrained.first_free;
       j["free_pieces"] = constrained.free_pieces;
       j["unconstrained"] = name(options.unconstrained);

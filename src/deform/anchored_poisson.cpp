@@ -19,8 +19,8 @@ using Sparse = Eigen::SparseMatrix<double>;
 AnchoredPoisson::AnchoredPoisson(const Sparse& K)
     : K_(K), anchored_(K.rows(), 0), position_(K.rows()), common_(new cholmod_common) {
   cholmod_start(common_);
-  // Factored supernodal (BLAS-3: half the time of a simplicial factorisation at 692k vertices),
-  // then turned into the simplicial LDL^T that rowadd, rowdel and the solver work on.
+  // Factored supernodal (BLAS-3: half the time of a simplicial factorisation at 692k vertices);
+  // turned into the simplicial LDL^T that rowadd and rowdel work on at the first update.
   common_->supernodal = CHOLMOD_SUPERNODAL;
   common_->final_ll = 0;
   common_->nmethods = 1;
@@ -49,8 +49,7 @@ AnchoredPoisson::~AnchoredPoisson() {
 void AnchoredPoisson::factorize() {
   cholmod_free_factor(&factor_, common_);
   factor_ = cholmod_copy_factor(symbolic_, common_);
-  {  // K's lower triangle, the anchors' rows and columns made identity; gone before the
-     // conversion below, which holds both forms of the factor for a moment
+  {  // K's lower triangle, the anchors' rows and columns made identity
     Sparse lower = K_.triangularView<Eigen::Lower>();
     for (int col = 0; col < lower.outerSize(); ++col) {
       for (Sparse::InnerIterator it(lower, col); it; ++it) {
@@ -63,10 +62,6 @@ void AnchoredPoisson::factorize() {
   }
   if (common_->status != CHOLMOD_OK || factor_->minor < factor_->n) {
     throw SolverError("deformation transfer: the Poisson system is singular");
-  }
-  cholmod_change_factor(CHOLMOD_REAL, false, false, true, true, factor_, common_);
-  if (common_->status != CHOLMOD_OK) {
-    throw SolverError("deformation transfer: converting the Poisson factorisation failed");
   }
 }
 
@@ -111,6 +106,12 @@ void AnchoredPoisson::set_anchors(const std::vector<int>& anchors) {
     factored_ = true;
     solver_.assign(factor_);
     return;
+  }
+  if (factor_->is_super) {  // both forms held for a moment
+    cholmod_change_factor(CHOLMOD_REAL, false, false, true, true, factor_, common_);
+    if (common_->status != CHOLMOD_OK) {
+      throw SolverError("deformation transfer: converting the Poisson factorisation failed");
+    }
   }
   for (const int v : add) {
     cholmod_rowdel(position_[v], nullptr, factor_, common_);

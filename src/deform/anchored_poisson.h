@@ -1,16 +1,14 @@
 // Internal: the Poisson system of deformation transfer with its anchors, K_anchored x = b, K the
 // cotangent stiffness of the detailed mesh and the anchors' rows and columns made identity.
 //
-// A simplicial LDL^T factorisation (CHOLMOD; computed supernodal, then converted) in a
-// nested-dissection ordering (METIS): it keeps neighbours close in memory and splits the work
-// evenly between two threads. When the anchor
-// set changes, newly anchored
-// vertices are removed with cholmod_rowdel and released ones put back with cholmod_rowadd (a
-// rank-2 update each), so a selection change costs in proportion to its difference; a change of
-// more than max(16, n / 2000) vertices is refactored from scratch (cheaper than so many
-// updates).
-// Solves run on two threads
-// (linalg/triangular_solver.h).
+// An LDL^T factorisation (CHOLMOD) in a nested-dissection ordering (METIS): it keeps neighbours
+// close in memory and splits the work evenly between two threads. Computed supernodal; at the
+// first change of the anchor set that is updated rather than refactored it turns simplicial
+// (both forms held for a moment: a solve needs neither, so a one-off solve never pays it).
+// Newly anchored vertices are removed with cholmod_rowdel and released ones put back with
+// cholmod_rowadd (a rank-2 update each), so a selection change costs in proportion to its
+// difference; a change of more than max(16, n / 2000) vertices is refactored from scratch
+// (cheaper than so many updates). Solves run on two threads (linalg/triangular_solver.h).
 #pragma once
 
 #include <vector>

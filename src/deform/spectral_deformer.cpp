@@ -88,6 +88,7 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
   const bool spectral = options_.solver == DeformSolver::Spectral;
   if (options_.energy == DeformEnergy::Arap) {
     arap_ = std::make_unique<ArapSolver>(mesh_, base_, spectral ? basis_ : nullptr, options_.arap);
+    clusters_ = arap_->clusters();
   }
   if (spectral) {
     reduced_ = std::make_unique<ReducedSolver>(
@@ -98,9 +99,11 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
     spatial_ = std::make_unique<SpatialSolver>(mesh_, options_);
   }
   setup_.reduced_system = clock.lap();
-  details_ = std::make_unique<DetailReconstruction>(mesh_, base_, options_.detail,
-                                                    options_.background_transfer);
-  setup_.detail_factorization = clock.lap();
+  if (!options_.single_solve) {
+    details_ = std::make_unique<DetailReconstruction>(mesh_, base_, options_.detail,
+                                                      options_.background_transfer);
+    setup_.detail_factorization = clock.lap();
+  }
   deformed_base_ = base_;
 }
 
@@ -129,9 +132,11 @@ void SpectralDeformer::set_selection(const Selection& selection) {
     setup_.reduced_system = clock.lap();  // the spatial solver's factorisation
   }
   clock.lap();
-  details_->set_anchors(constrained_.vertices);
-  if (options_.detail == DetailMethod::Transfer && !options_.background_transfer) {
-    setup_.detail_factorization = clock.lap();
+  if (details_) {
+    details_->set_anchors(constrained_.vertices);
+    if (options_.detail == DetailMethod::Transfer && !options_.background_transfer) {
+      setup_.detail_factorization = clock.lap();
+    }
   }
   setup_.selection = total.lap();
   detail_targets_.resize(0, 3);
@@ -140,6 +145,9 @@ void SpectralDeformer::set_selection(const Selection& selection) {
 
 Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms) {
   if (constrained_.vertices.empty()) throw InputError("deformation: no selection set");
+  if (options_.single_solve && !reduced_ && !spatial_) {
+    throw InputError("deformation: a single-solve deformer solves once");
+  }
   Clock clock, total;
   const Eigen::MatrixX3d base_targets = constraint_targets(constrained_, base_, transforms);
   Eigen::MatrixX3d displacement_targets = base_targets;
@@ -187,6 +195,18 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
   const std::vector<int>& constrained = constrained_.vertices;
   for (size_t i = constrained_.first_free; i < constrained.size(); ++i)
     deformed_base_.row(constrained[i]) = base_.row(constrained[i]);
+  double deferred = 0.0;
+  if (options_.single_solve) {  // the solvers' memory back before the details take theirs
+    clock.lap();
+    basis_.reset();
+    basis32_ = Eigen::MatrixXf();
+    reduced_.reset();
+    spatial_.reset();
+    arap_.reset();
+    details_ = std::make_unique<DetailReconstruction>(mesh_, base_, options_.detail);
+    details_->set_anchors(constrained_.vertices);
+    deferred = setup_.detail_factorization = clock.lap();
+  }
   detail_targets_ = options_.detail == DetailMethod::None
                         ? base_targets
                         : constraint_targets(constrained_, mesh_.V, transforms);
@@ -205,7 +225,7 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
     }
   }
   frame_.detail = clock.lap();
-  frame_.total = total.lap();
+  frame_.total = total.lap() - deferred;
   return result;
 }
 
@@ -229,7 +249,10 @@ Vertices deform(const TriangleMesh& mesh, const ManifoldHarmonics& basis,
                 const DeformOptions& options) {
   // The deformer lives only in this call: it may use the caller's basis without owning it.
   const std::shared_ptr<const ManifoldHarmonics> borrowed(std::shared_ptr<void>(), &basis);
-  SpectralDeformer deformer(mesh, borrowed, options);
+  DeformOptions once = options;
+  once.single_solve = true;
+  once.background_transfer = false;
+  SpectralDeformer deformer(mesh, borrowed, once);
   deformer.set_selection(selection);
   return deformer.solve(transforms);
 }

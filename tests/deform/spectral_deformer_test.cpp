@@ -347,6 +347,36 @@ TEST(SpectralDeformer, SelectionChangesMatchAFreshStart) {
   }
 }
 
+// single_solve (deform()): the same result as a deformer built for many frames, for every detail
+// method and both solvers, having released the basis; it solves once.
+TEST(SpectralDeformer, ASingleSolveEqualsTheReusableDeformer) {
+  const BarScene s = bar_scene(8);
+  const auto h = std::make_shared<const ManifoldHarmonics>(harmonics(s.mesh, 40));
+  const std::vector<Eigen::Affine3d> turn{rotation_about({4.0, 0.5, 0.5}, 40.0)};
+  for (const DeformSolver solver : {DeformSolver::Spectral, DeformSolver::Spatial}) {
+    for (const DetailMethod method : kMethods) {
+      DeformOptions o;
+      o.solver = solver;
+      o.detail = method;
+      SpectralDeformer reusable(s.mesh, h, o);
+      reusable.set_selection(s.selection);
+      const Vertices expected = reusable.solve(turn);
+      o.single_solve = true;
+      SpectralDeformer once(s.mesh, h, o);
+      once.set_selection(s.selection);
+      EXPECT_LT((once.solve(turn) - expected).cwiseAbs().maxCoeff(), 1e-12)
+          << name(solver) << ", " << name(method);
+      EXPECT_EQ(once.basis(), nullptr);
+      EXPECT_EQ(once.rotation_clusters(), reusable.rotation_clusters());
+      EXPECT_THROW(once.solve(turn), InputError);
+      EXPECT_LT((deform(s.mesh, *h, s.selection, turn, o) - expected).cwiseAbs().maxCoeff(), 1e-12);
+    }
+  }
+  DeformOptions both;
+  both.single_solve = both.background_transfer = true;
+  EXPECT_THROW(both.validate(), InputError);
+}
+
 TEST(SpectralDeformer, ClearErrors) {
   const BarScene s = bar_scene(6);
   const ManifoldHarmonics h = harmonics(s.mesh, 30);

@@ -75,6 +75,11 @@ struct DeformOptions {
   // selection's factorisation is ready, frames add the details as displacements
   // (SpectralDeformer::detail_pending). For interactive front ends.
   bool background_transfer = false;
+  // One solve only (deform(), the command line's deform): the deformer releases the basis and
+  // the reduced solvers once the deformed base is solved, and only then builds and factors the
+  // detail reconstruction, so that the two never take memory at once (2.77M vertices: the
+  // peak 8.4 -> 5.x GB). A second solve() is an InputError. Not with background_transfer.
+  bool single_solve = false;
 
   // Throws InputError, naming the field, for a value out of range.
   void validate() const;

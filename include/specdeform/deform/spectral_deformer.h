@@ -17,6 +17,9 @@
 // (UnconstrainedPieces::Follow, deform/free_pieces.h), stays where it is (Keep) or is an
 // InputError.
 //
+// With DeformOptions::single_solve the deformer solves once, releasing the basis before it
+// builds the details (basis() is then null): deform() below.
+//
 //   SpectralDeformer deformer(mesh, compute_manifold_harmonics(mesh, {.num_modes = 100}));
 //   deformer.set_selection({.handles = {hand}, .fixed = feet});
 //   Vertices frame = deformer.solve({Eigen::Affine3d(Eigen::Translation3d(0, 0.1, 0))});
@@ -50,7 +53,8 @@ struct SetupTimings {
                                       // last selection
   double detail_factorization = 0.0;  // Transfer: Poisson analysis (once per mesh), then the
                                       // factorisation or its update for the last selection
-                                      // (background_transfer: none, that runs aside)
+                                      // (background_transfer: none, that runs aside;
+                                      // single_solve: all of it, done in solve())
   double selection = 0.0;             // the whole of the last set_selection()
 };
 
@@ -98,7 +102,7 @@ class SpectralDeformer {
   // ARAP: the iterations of the last solve (the linear energy: none, converged).
   const ArapReport& arap_report() const { return arap_report_; }
   // ARAP: the number of rotation clusters (0 for the linear energy).
-  int rotation_clusters() const { return arap_ ? arap_->clusters() : 0; }
+  int rotation_clusters() const { return clusters_; }
   // Connected components without a constrained vertex in the last selection (they follow the
   // surface or are held in place, as options().unconstrained says).
   int free_pieces() const { return constrained_.free_pieces; }
@@ -109,10 +113,15 @@ class SpectralDeformer {
   // options().background_transfer (DetailReconstruction's background): whether the transfer's
   // factorisation for the last selection still runs (solve() adds displacements meanwhile),
   // waiting for it, and a callback on the background thread when it completes.
-  bool detail_pending() const { return !details_->ready(); }
-  void wait_for_detail() const { details_->wait(); }
-  void on_detail_ready(std::function<void()> callback) { details_->on_ready(std::move(callback)); }
-  DetailMethod applied_detail() const { return details_->applied(); }  // by the last solve()
+  bool detail_pending() const { return details_ && !details_->ready(); }
+  void wait_for_detail() const {
+    if (details_) details_->wait();
+  }
+  void on_detail_ready(std::function<void()> callback) {
+    if (details_) details_->on_ready(std::move(callback));
+  }
+  // By the last solve() (options().detail before the first with single_solve).
+  DetailMethod applied_detail() const { return details_ ? details_->applied() : options_.detail; }
 
  private:
   TriangleMesh mesh_;
@@ -123,10 +132,11 @@ class SpectralDeformer {
   std::unique_ptr<ReducedSolver> reduced_;
   std::unique_ptr<SpatialSolver> spatial_;
   std::unique_ptr<ArapSolver> arap_;
-  std::unique_ptr<DetailReconstruction> details_;
-  std::unique_ptr<detail::FreePieces> follow_;  // Follow: the free pieces of the selection
-  Eigen::VectorXi components_;                  // connected component of each vertex
+  std::unique_ptr<DetailReconstruction> details_;  // single_solve: built in solve()
+  std::unique_ptr<detail::FreePieces> follow_;     // Follow: the free pieces of the selection
+  Eigen::VectorXi components_;                     // connected component of each vertex
   int num_components_ = 0;
+  int clusters_ = 0;              // ARAP's rotation clusters
   std::vector<int> piece_modes_;  // the basis's modes on each connected component
   std::vector<int> constrained_piece_modes_;
   ConstrainedSet constrained_;
@@ -139,7 +149,8 @@ class SpectralDeformer {
 };
 
 // One deformation, start to finish: the detailed result of `selection` moved by `transforms`
-// (SpectralDeformer's set_selection and solve once). The basis is used, not copied.
+// (SpectralDeformer's set_selection and solve once, with single_solve). The basis is used, not
+// copied.
 Vertices deform(const TriangleMesh& mesh, const ManifoldHarmonics& basis,
                 const Selection& selection, const std::vector<Eigen::Affine3d>& transforms,
                 const DeformOptions& options = {});
