@@ -124,6 +124,50 @@ std::vector<int> transfer_donors(const TriangleMesh& detailed, const Vertices& b
   return donor;
 }
 
+// Q_f = A_f [grad phi_a; grad phi_b; grad phi_c] [grad x, grad y, grad z] of face f (rows:
+// its corners; zero for a degenerate face): the basis functions' gradients times the detailed
+// coordinates' gradients, area-weighted.
+Eigen::Matrix3d corner_gradients(const TriangleMesh& mesh, int f) {
+  Eigen::Matrix3d X;  // rows: the corners' positions
+  for (int k = 0; k < 3; ++k) X.row(k) = mesh.V.row(mesh.F(f, k));
+  if (is_degenerate_triangle(X.row(0), X.row(1), X.row(2))) return Eigen::Matrix3d::Zero();
+  const Eigen::Vector3d normal = (X.row(1) - X.row(0)).cross(X.row(2) - X.row(0));
+  Eigen::Matrix3d g;  // rows: grad phi_k = (n x e_k) / |n|^2, e_k the edge opposite corner k
+  for (int k = 0; k < 3; ++k) {
+    g.row(k) = normal.cross(Eigen::Vector3d(X.row((k + 2) % 3) - X.row((k + 1) % 3))) /
+               normal.squaredNorm();
+  }
+  return 0.5 * normal.norm() * g * (g.transpose() * X);
+}
+
+// A compressed row-major matrix from each row's (column, value) entries, rows i at
+// [start[i], start[i + 1]) of `entries`: each row sorted by column, the values of equal columns
+// summed in their order (as setFromTriplets sums them).
+Eigen::SparseMatrix<double, Eigen::RowMajor> compressed_rows(
+    int rows, int cols, const std::vector<int>& start,
+    std::vector<std::pair<int, double>>& entries) {
+  Eigen::SparseMatrix<double, Eigen::RowMajor> A(rows, cols);
+  A.resizeNonZeros(static_cast<Eigen::Index>(entries.size()));
+  int* outer = A.outerIndexPtr();
+  int at = 0;
+  outer[0] = 0;
+  for (int i = 0; i < rows; ++i) {
+    const auto begin = entries.begin() + start[i], end = entries.begin() + start[i + 1];
+    std::stable_sort(begin, end, [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (auto e = begin; e != end; ++e) {
+      if (at > outer[i] && A.innerIndexPtr()[at - 1] == e->first) {
+        A.valuePtr()[at - 1] += e->second;
+      } else {
+        A.innerIndexPtr()[at] = e->first;
+        A.valuePtr()[at++] = e->second;
+      }
+    }
+    outer[i + 1] = at;
+  }
+  A.resizeNonZeros(at);
+  return A;
+}
+
 }  // namespace
 
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
@@ -309,9 +353,6 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
 
 void DetailReconstruction::Poisson::build(const TriangleMesh& detailed, const Vertices& base) {
   Poisson& p = *this;
-  const Sparse G = gradient_operator(detailed);
-  const Eigen::VectorXd areas = face_areas(detailed);
-  const Eigen::MatrixX3d J = G * detailed.V;  // rows 3f..3f+2: gradients of x, y, z
   const int nf = detailed.num_faces();
   const int n = detailed.num_vertices();
   p.system = std::make_unique<detail::AnchoredPoisson>(cotan_stiffness(detailed));
@@ -329,37 +370,55 @@ void DetailReconstruction::Poisson::build(const TriangleMesh& detailed, const Ve
   std::vector<int> slot(nf);  // face f of the mesh is face slot[f] here
   for (int g = 0; g < nf; ++g) slot[face_order[g]] = g;
   const std::vector<int> donors = transfer_donors(detailed, base);
+  // Per face (numbered here) on two threads: P_f = Q_f B_d^-T of its donor d (f itself where
+  // its base triangle is sound), or Q_f where S_f = I.
+  std::vector<Eigen::Matrix3d> P(nf);
+  detail::split_in_two(nf, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index g = begin; g < end; ++g) {
+      const int f = face_order[g];
+      P[g] = corner_gradients(detailed, f);
+      if (donors[f] >= 0) P[g] *= triangle_frame(base, detailed.F, donors[f]).inverse().transpose();
+    }
+  });
+  // The rows of `edges` and `normals` by counting: three entries and one per corner.
   p.faces.resize(nf, 3);
-  std::vector<Eigen::Triplet<double>> edges, normals;
   p.constant = RowMajor::Zero(n, 3);
+  std::vector<int> edge_start(n + 1, 0), normal_start(n + 1, 0);
   for (int g = 0; g < nf; ++g) {  // face g here is face f of the mesh
     const int f = face_order[g];
     for (int k = 0; k < 3; ++k) p.faces(g, k) = p.rank[detailed.F(f, k)];
-    Eigen::Matrix3d corners = Eigen::Matrix3d::Zero();  // rows: corners, columns: x, y, z
-    for (int k = 0; k < 3; ++k)
-      for (int d = 0; d < 3; ++d) corners(k, d) = G.coeff(3 * f + d, detailed.F(f, k));
-    const Eigen::Matrix3d Q = areas[f] * corners * J.middleRows<3>(3 * f);
-    const int donor = donors[f];
-    if (donor < 0) {  // S_f = I
-      for (int r = 0; r < 3; ++r) p.constant.row(p.faces(g, r)) += Q.row(r);
-      continue;
+    for (int r = 0; r < 3; ++r) {
+      if (donors[f] < 0) {  // S_f = I
+        p.constant.row(p.faces(g, r)) += P[g].row(r);
+      } else {
+        edge_start[p.faces(g, r) + 1] += 3;
+        normal_start[p.faces(g, r) + 1] += 1;
+      }
     }
-    // S_f = B'_d B_d^-1 of the donor d (f itself where its base triangle is sound).
-    const Eigen::Matrix3d P = Q * triangle_frame(base, detailed.F, donor).inverse().transpose();
+  }
+  for (int i = 0; i < n; ++i) {
+    edge_start[i + 1] += edge_start[i];
+    normal_start[i + 1] += normal_start[i];
+  }
+  std::vector<std::pair<int, double>> edges(edge_start[n]), normals(normal_start[n]);
+  std::vector<int> edge_at(edge_start.begin(), edge_start.end() - 1);
+  std::vector<int> normal_at(normal_start.begin(), normal_start.end() - 1);
+  for (int g = 0; g < nf; ++g) {
+    const int donor = donors[face_order[g]];
+    if (donor < 0) continue;
     const int a = p.rank[detailed.F(donor, 0)], b = p.rank[detailed.F(donor, 1)],
               c = p.rank[detailed.F(donor, 2)];
     for (int r = 0; r < 3; ++r) {  // P(r, :) [c' - a', b' - a', n']^T
       const int v = p.faces(g, r);
-      edges.emplace_back(v, c, P(r, 0));
-      edges.emplace_back(v, b, P(r, 1));
-      edges.emplace_back(v, a, -P(r, 0) - P(r, 1));
-      normals.emplace_back(v, slot[donor], P(r, 2));
+      edges[edge_at[v]++] = {c, P[g](r, 0)};
+      edges[edge_at[v]++] = {b, P[g](r, 1)};
+      edges[edge_at[v]++] = {a, -P[g](r, 0) - P[g](r, 1)};
+      normals[normal_at[v]++] = {slot[donor], P[g](r, 2)};
     }
   }
-  p.edges.resize(n, n);
-  p.edges.setFromTriplets(edges.begin(), edges.end());
-  p.normals.resize(n, nf);
-  p.normals.setFromTriplets(normals.begin(), normals.end());
+  P = {};
+  p.edges = compressed_rows(n, n, edge_start, edges);
+  p.normals = compressed_rows(n, nf, normal_start, normals);
 }
 
 DetailReconstruction::~DetailReconstruction() = default;
