@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <condition_variable>
 #include <mutex>
 #include <optional>
@@ -75,51 +76,79 @@ std::pair<double, double> edge_singular_values(const Vertices& V, const Faces& F
 }
 
 // Per face, the face whose base deformation gradient it takes: itself where its base triangle is
-// sound, else the nearest sound face through shared edges (breadth first), or -1 where its
-// connected piece has none (its gradient is then the identity: the piece keeps its shape).
+// sound, else the nearest sound face through shared edges (breadth first from all sound faces
+// in order, each face's edges in the order of their sorted ends and the faces on an edge by
+// index), or -1 where its connected piece has none (its gradient is then the identity: the piece
+// keeps its shape). Only the sound faces beside an unsound one can give anything, so the walk
+// starts from those alone, and it finds the faces on an edge through the vertices' face lists.
 std::vector<int> transfer_donors(const TriangleMesh& detailed, const Vertices& base) {
   const int nf = detailed.num_faces();
   std::vector<int> donor(nf, -1);
-  std::vector<int> queue;
-  for (int f = 0; f < nf; ++f) {
-    const double size = edge_singular_values(detailed.V, detailed.F, f).first;
-    const auto [large, small] = edge_singular_values(base, detailed.F, f);
-    if (large > kMinRelativeSize * size && small > kMinAspect * large) {
-      donor[f] = f;
-      queue.push_back(f);
+  std::atomic<bool> all_sound = true;
+  detail::split_in_two(nf, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index f = begin; f < end; ++f) {
+      const double size = edge_singular_values(detailed.V, detailed.F, f).first;
+      const auto [large, small] = edge_singular_values(base, detailed.F, f);
+      if (large > kMinRelativeSize * size && small > kMinAspect * large) {
+        donor[f] = static_cast<int>(f);
+      } else {
+        all_sound = false;
+      }
     }
-  }
-  if (static_cast<int>(queue.size()) == nf) return donor;
-  // The faces' edges, sorted, to walk from face to face: (smaller vertex, larger vertex, face).
-  std::vector<std::array<int, 3>> edges;
-  for (int f = 0; f < nf; ++f) {
+  });
+  if (all_sound) return donor;
+  const int n = detailed.num_vertices();
+  std::vector<int> start(n + 1, 0), incident(3 * size_t(nf));  // each vertex's faces, ascending
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) ++start[detailed.F(f, k) + 1];
+  for (int i = 0; i < n; ++i) start[i + 1] += start[i];
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) incident[fill[detailed.F(f, k)]++] = f;
+  // Calls visit(g) for each face g sharing an edge with f (f too), in the order above.
+  const auto for_each_neighbour = [&](int f, auto&& visit) {
+    std::array<std::pair<int, int>, 3> edges;
     for (int k = 0; k < 3; ++k) {
       const int a = detailed.F(f, k), b = detailed.F(f, (k + 1) % 3);
-      edges.push_back({std::min(a, b), std::max(a, b), f});
+      edges[k] = {std::min(a, b), std::max(a, b)};
     }
-  }
-  std::sort(edges.begin(), edges.end());
-  std::vector<std::array<int, 3>> by_face(nf);  // each face's three entries in `edges`
-  std::vector<int> filled(nf, 0);
-  for (int e = 0; e < static_cast<int>(edges.size()); ++e) {
-    by_face[edges[e][2]][filled[edges[e][2]]++] = e;
-  }
-  const auto same_edge = [&](int e, int o) {
-    return edges[e][0] == edges[o][0] && edges[e][1] == edges[o][1];
-  };
-  for (size_t head = 0; head < queue.size(); ++head) {
-    const int f = queue[head];
-    for (const int e : by_face[f]) {
-      int first = e;  // the faces sharing edge e are a run of equal (a, b)
-      while (first > 0 && same_edge(first - 1, e)) --first;
-      for (int o = first; o < static_cast<int>(edges.size()) && same_edge(o, e); ++o) {
-        const int g = edges[o][2];
-        if (donor[g] < 0) {
-          donor[g] = donor[f];
-          queue.push_back(g);
+    std::sort(edges.begin(), edges.end());
+    for (const auto& [a, b] : edges) {
+      const int* p = incident.data() + start[a];
+      const int* p_end = incident.data() + start[a + 1];
+      const int* q = incident.data() + start[b];
+      const int* q_end = incident.data() + start[b + 1];
+      while (p != p_end && q != q_end) {  // the faces on both ends, ascending
+        if (*p < *q) {
+          ++p;
+        } else if (*q < *p) {
+          ++q;
+        } else {
+          visit(*p);
+          ++p;
+          ++q;
         }
       }
     }
+  };
+  std::vector<char> source(nf, 0);
+  for (int f = 0; f < nf; ++f) {
+    if (donor[f] >= 0) continue;
+    for_each_neighbour(f, [&](int g) {
+      if (donor[g] >= 0) source[g] = 1;
+    });
+  }
+  std::vector<int> queue;
+  for (int f = 0; f < nf; ++f)
+    if (source[f]) queue.push_back(f);
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const int f = queue[head];
+    for_each_neighbour(f, [&](int g) {
+      if (donor[g] < 0) {
+        donor[g] = donor[f];
+        queue.push_back(g);
+      }
+    });
   }
   return donor;
 }

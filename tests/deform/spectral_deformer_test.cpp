@@ -263,6 +263,25 @@ TEST(DetailReconstruction, TransferFollowsARigidlyTurnedBase) {
       1e-3);
 }
 
+// A base triangle made a sliver (one corner moved onto its opposite edge) carries no usable
+// gradient; it takes the nearest sound triangle's, so a rigidly moved base still moves the
+// detailed mesh rigidly (with the identity there, it would not).
+TEST(DetailReconstruction, AnUnsoundBaseTriangleTakesItsNeighboursGradient) {
+  const BarScene s = bar_scene(6);
+  const ManifoldHarmonics h = harmonics(s.mesh, 40);
+  Vertices base = SpectralDeformer(s.mesh, h).base();
+  const int f = s.mesh.num_faces() / 2;
+  const int a = s.mesh.F(f, 0), b = s.mesh.F(f, 1), c = s.mesh.F(f, 2);
+  base.row(c) = 0.5 * (base.row(a) + base.row(b));
+  const Eigen::Affine3d motion = Eigen::Translation3d(0.3, 0.2, 0.1) *
+                                 Eigen::AngleAxisd(1.1, Eigen::Vector3d(0, 1, 1).normalized());
+  const Vertices expected = (motion * s.mesh.V.transpose()).transpose();
+  DetailReconstruction transfer(s.mesh, base, DetailMethod::Transfer);
+  transfer.set_anchors({17});
+  const Vertices out = transfer.apply((motion * base.transpose()).transpose(), expected.row(17));
+  EXPECT_LT((out - expected).cwiseAbs().maxCoeff(), 1e-9);
+}
+
 TEST(SpectralDeformer, TransferKeepsTheBumpsUnderBending) {
   const BarScene s = bar_scene(10);
   expect_transfer_keeps_details(
