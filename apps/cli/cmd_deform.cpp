@@ -33,7 +33,9 @@ void add_deform_command(CLI::App& app) {
                 "single-precision basis in the frame");
   cmd->add_option("--basis", args->basis,
                   "basis cache: read if it exists (and matches the mesh), written otherwise");
-  cmd->add_option("--repeat", args->repeat, "solve the frame N times, report medians (default 1)")
+  cmd->add_option("--repeat", args->repeat,
+                  "solve the frame N times, report medians (default 1; one solve frees the basis "
+                  "before the details' factorisation, N > 1 keeps both in memory)")
       ->check(CLI::Range(1, 100000));
   cmd->add_flag("--json", args->json, "print one JSON object with timings and errors");
   add_harmonics_options(*cmd, args->harmonics);
