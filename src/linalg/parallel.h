@@ -4,11 +4,13 @@
 // 500 us. Between jobs it polls (yielding) for a short while, then sleeps. It runs one job at a
 // time; a caller that finds it busy (another deformer on another
 // thread) starts a thread of its own. Either way the two halves run at the same time, so they
-// may synchronise with each other (a std::barrier). Jobs must not throw.
+// may synchronise with each other (a std::barrier). HelperThread's jobs must not throw;
+// run_pair and split_in_two carry their functions' exceptions back to the caller.
 #pragma once
 
 #include <atomic>
 #include <condition_variable>
+#include <exception>
 #include <functional>
 #include <mutex>
 #include <thread>
@@ -38,11 +40,28 @@ class HelperThread {
   std::thread thread_;
 };
 
-// Runs first() and second() at the same time, on two threads.
+// Runs first() and second() at the same time, on two threads. An exception of either is
+// rethrown once both have ended (first()'s where both throw).
 template <typename First, typename Second>
 void run_pair(First&& first, Second&& second) {
-  HelperThread::instance().run(std::function<void()>(std::forward<First>(first)),
-                               std::function<void()>(std::forward<Second>(second)));
+  std::exception_ptr failed[2];
+  HelperThread::instance().run(
+      [&] {
+        try {
+          first();
+        } catch (...) {
+          failed[0] = std::current_exception();
+        }
+      },
+      [&] {
+        try {
+          second();
+        } catch (...) {
+          failed[1] = std::current_exception();
+        }
+      });
+  for (const std::exception_ptr& e : failed)
+    if (e) std::rethrow_exception(e);
 }
 
 // Runs body(begin, end) on [0, n) in two halves at the same time.
