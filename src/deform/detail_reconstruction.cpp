@@ -154,19 +154,15 @@ std::vector<int> transfer_donors(const TriangleMesh& detailed, const Vertices& b
 }
 
 // Q_f = A_f [grad phi_a; grad phi_b; grad phi_c] [grad x, grad y, grad z] of face f (rows:
-// its corners; zero for a degenerate face): the basis functions' gradients times the detailed
+// its corners; zero for a degenerate face): the hat functions' gradients times the detailed
 // coordinates' gradients, area-weighted.
 Eigen::Matrix3d corner_gradients(const TriangleMesh& mesh, int f) {
   Eigen::Matrix3d X;  // rows: the corners' positions
   for (int k = 0; k < 3; ++k) X.row(k) = mesh.V.row(mesh.F(f, k));
-  if (is_degenerate_triangle(X.row(0), X.row(1), X.row(2))) return Eigen::Matrix3d::Zero();
-  const Eigen::Vector3d normal = (X.row(1) - X.row(0)).cross(X.row(2) - X.row(0));
-  Eigen::Matrix3d g;  // rows: grad phi_k = (n x e_k) / |n|^2, e_k the edge opposite corner k
-  for (int k = 0; k < 3; ++k) {
-    g.row(k) = normal.cross(Eigen::Vector3d(X.row((k + 2) % 3) - X.row((k + 1) % 3))) /
-               normal.squaredNorm();
-  }
-  return 0.5 * normal.norm() * g * (g.transpose() * X);
+  const double area =
+      0.5 * Eigen::Vector3d(X.row(1) - X.row(0)).cross(Eigen::Vector3d(X.row(2) - X.row(0))).norm();
+  const Eigen::Matrix3d g = hat_gradients(mesh, f);
+  return area * g * (g.transpose() * X);
 }
 
 // A compressed row-major matrix from each row's (column, value) entries, rows i at

@@ -104,21 +104,28 @@ Eigen::SparseMatrix<double> cotan_stiffness(const TriangleMesh& mesh) {
   return K;
 }
 
+Eigen::Matrix3d hat_gradients(const TriangleMesh& mesh, int f) {
+  const Eigen::Vector3d p[3] = {mesh.V.row(mesh.F(f, 0)), mesh.V.row(mesh.F(f, 1)),
+                                mesh.V.row(mesh.F(f, 2))};
+  if (is_degenerate_triangle(p[0], p[1], p[2])) return Eigen::Matrix3d::Zero();
+  const Eigen::Vector3d normal = (p[1] - p[0]).cross(p[2] - p[0]);
+  Eigen::Matrix3d g;
+  for (int k = 0; k < 3; ++k) {
+    // grad phi_k = (n x e_k) / |n|^2, e_k the edge opposite to corner k, counter-clockwise.
+    g.row(k) =
+        normal.cross(Eigen::Vector3d(p[(k + 2) % 3] - p[(k + 1) % 3])) / normal.squaredNorm();
+  }
+  return g;
+}
+
 Eigen::SparseMatrix<double> gradient_operator(const TriangleMesh& mesh) {
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(9 * size_t(mesh.num_faces()));
   for (int f = 0; f < mesh.num_faces(); ++f) {
-    const Eigen::Vector3d p[3] = {mesh.V.row(mesh.F(f, 0)), mesh.V.row(mesh.F(f, 1)),
-                                  mesh.V.row(mesh.F(f, 2))};
-    if (is_degenerate_triangle(p[0], p[1], p[2])) continue;
-    const Eigen::Vector3d normal = (p[1] - p[0]).cross(p[2] - p[0]);
-    const double double_area_sq = normal.squaredNorm();
-    for (int k = 0; k < 3; ++k) {
-      // grad phi_k = (n x e_k) / (2 A), e_k the edge opposite to corner k, counter-clockwise.
-      const Eigen::Vector3d e = p[(k + 2) % 3] - p[(k + 1) % 3];
-      const Eigen::Vector3d g = normal.cross(e) / double_area_sq;
-      for (int d = 0; d < 3; ++d) triplets.emplace_back(3 * f + d, mesh.F(f, k), g[d]);
-    }
+    const Eigen::Matrix3d g = hat_gradients(mesh, f);
+    if (g.isZero(0.0)) continue;  // degenerate: no entries
+    for (int k = 0; k < 3; ++k)
+      for (int d = 0; d < 3; ++d) triplets.emplace_back(3 * f + d, mesh.F(f, k), g(k, d));
   }
   Eigen::SparseMatrix<double> G(3 * mesh.num_faces(), mesh.num_vertices());
   G.setFromTriplets(triplets.begin(), triplets.end());

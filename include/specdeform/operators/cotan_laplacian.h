@@ -9,6 +9,7 @@
 // scale. Degenerate triangles (is_degenerate_triangle) contribute nothing.
 #pragma once
 
+#include <Eigen/Core>
 #include <Eigen/Sparse>
 
 #include "specdeform/mesh/triangle_mesh.h"
@@ -17,6 +18,10 @@ namespace specdeform {
 
 // n x n, symmetric positive semidefinite, compressed.
 Eigen::SparseMatrix<double> cotan_stiffness(const TriangleMesh& mesh);
+
+// 3 x 3: row k the (constant) gradient on triangle f of the hat function of its corner k
+// (zero for a degenerate triangle).
+Eigen::Matrix3d hat_gradients(const TriangleMesh& mesh, int f);
 
 // 3f x n: rows 3t, 3t+1, 3t+2 hold the x, y, z components of the (constant) gradient of a
 // piecewise-linear function on triangle t. With D = diag(area_t repeated three times),
