@@ -42,8 +42,13 @@ KrylovSchurResult krylov_schur(ShiftInvert& op, const MassOperator& M, const Bas
   const int b = set.block, s = set.subspace;
   const int width = (b + 7) / 8 * 8;  // basis_sweep's blocks: a multiple of 8 columns
   const double sigma = op.sigma();
+  // The basis is kept lagged: V's first k columns are V_true L (L unit upper triangular, V_true
+  // the M-orthonormal Krylov basis of the relation), and the next block Q is Q_true + V_true E
+  // (E: its second Gram-Schmidt pass's coefficients, never subtracted). The next block's
+  // projections remove that part along V_true anyway; only their coefficients are corrected,
+  // through the relation: two passes over V per block instead of three.
   RowMatrix V(n, s);
-  Mat T(0, 0), F(0, b);
+  Mat T(0, 0), F(0, b), L(0, 0), E(0, b);
   int k = 0;
   Mat start = random_block(n, b, rng);
   orthonormalize(start, {found}, M, rng);
@@ -53,6 +58,19 @@ KrylovSchurResult krylov_schur(ShiftInvert& op, const MassOperator& M, const Bas
   // permutation then moves whole rows.
   RowMatrix X = RowMatrix::Zero(n, width), D1, D2, gram, MQ, solved;
   Mat W;
+  // (x, in V_true's coordinates) -> the same in V's, and for the lagged projections
+  // V^T M y = L^T V_true^T M y the way back.
+  const auto to_stored = [](const Mat& l, const Mat& x) {
+    return Mat(l.triangularView<Eigen::UnitUpper>().solve(x));
+  };
+  const auto to_true = [](const Mat& l, const RowMatrix& p, int cols) {
+    return Mat(l.triangularView<Eigen::UnitUpper>().transpose().solve(p.leftCols(cols)));
+  };
+  const auto padded = [&](const Mat& x) {  // as basis_sweep takes coefficients
+    RowMatrix p = RowMatrix::Zero(x.rows(), width);
+    p.leftCols(x.cols()) = x;
+    return p;
+  };
   int steps = 0, last_converged = 0;
   double estimate = 2.0 * (s / b), done = 0.0;  // total block steps, fraction reported
   for (;;) {
@@ -60,36 +78,53 @@ KrylovSchurResult krylov_schur(ShiftInvert& op, const MassOperator& M, const Bas
       done = std::max(done, std::min(0.99, steps++ / estimate));
       progress(done);
       V.middleCols(k, b) = Q;
+      Mat Lx = Mat::Identity(k + b, k + b);
+      Lx.topLeftCorner(k, k) = L;
+      Lx.topRightCorner(k, b) = E;
       M.apply(Q, MQ);
       op.solve(MQ, solved);
       out.solves += b;
-      // W = V C + Q' R: block classical Gram-Schmidt against V, twice, each pass's subtraction
-      // fused with the next one's projection; then Cholesky QR within the block.
-      X.leftCols(b) = solved;
-      M.project(V, k + b, X, nullptr, &D1, nullptr);
-      M.project(V, k + b, X, &D1, &D2, nullptr);
-      M.project(V, k + b, X, &D2, nullptr, near.cols() > 0 ? nullptr : &gram);
-      const Mat C = (D1 + D2).leftCols(b);
+      // Block classical Gram-Schmidt against V_true, twice, each pass's subtraction fused with
+      // the next one's projection; the second pass's subtraction is lagged (E) where the block
+      // can be normalised by Cholesky QR alone. A Q_true = A Q - A V_true E = A Q - V_true
+      // (T E) - Q_true (F^T E) by the relation: a part in the span of V_true, which the
+      // projections take out anyway, so only its coefficients change.
       if (near.cols() > 0) {
-        W = X.leftCols(b);
+        W = solved;
         project_out(W, {near}, M);
         X.leftCols(b) = W;
-        gram = M.gram(W);
+      } else {
+        X.leftCols(b) = solved;
       }
+      M.project(V, k + b, X, nullptr, &D1, nullptr);
+      Mat C1 = to_true(Lx, D1, b);
+      D1 = padded(to_stored(Lx, C1));
+      C1.topRows(k) -= T * E;
+      C1.bottomRows(b) -= F.transpose() * E;
+      M.project(V, k + b, X, &D1, &D2, &gram);
+      Mat C2 = to_true(Lx, D2, b);
+      const Mat C = C1 + C2;
       Mat R = Mat::Identity(b, b);
-      if (!cholesky_qr2(X.leftCols(b), M, R, gram.topLeftCorner(b, b))) {  // ill-conditioned
+      if (!cholesky_qr2(X.leftCols(b), M, R, gram.topLeftCorner(b, b), &C2)) {
+        D2 = padded(to_stored(Lx, C2));  // the second pass's subtraction, now
+        M.project(V, k + b, X, &D2, nullptr, nullptr);
+        C2.setZero();
         W = X.leftCols(b);
-        Mat Rg = Mat::Zero(b, b);
-        column_gram_schmidt(W, M, 1e-10, Rg, [&](int j) {
-          // invariant subspace found: continue with a fresh direction
-          Mat fresh = random_block(n, 1, rng);
-          orthonormalize(fresh, {found, Mat(V.leftCols(k + b)), W.leftCols(j)}, M, rng);
-          W.col(j) = fresh.col(0);
-        });
+        if (!cholesky_qr2(W, M, R)) {  // ill-conditioned
+          Mat Rg = Mat::Zero(b, b);
+          column_gram_schmidt(W, M, 1e-10, Rg, [&](int j) {
+            // invariant subspace found: continue with a fresh direction
+            Mat fresh = random_block(n, 1, rng);
+            orthonormalize(fresh, {found, Mat(V.leftCols(k + b)), W.leftCols(j)}, M, rng);
+            W.col(j) = fresh.col(0);
+          });
+          R = Rg * R;
+        }
         X.leftCols(b) = W;
-        R = Rg * R;
       }
       Q = X.leftCols(b);
+      E = C2;
+      L = std::move(Lx);
       Mat Tn = Mat::Zero(k + b, k + b);
       Tn.topLeftCorner(k, k) = T;
       Tn.bottomLeftCorner(b, k) = F.transpose();
@@ -98,6 +133,12 @@ KrylovSchurResult krylov_schur(ShiftInvert& op, const MassOperator& M, const Bas
       F = Mat::Zero(k + b, b);
       F.bottomRows(b) = R.transpose();
       k += b;
+    }
+    if (!E.isZero(0.0)) {  // the block waiting outside V: Q_true = Q - V_true E
+      X.leftCols(b) = Q;
+      D2 = padded(to_stored(L, E));
+      M.project(V, k, X, &D2, nullptr, nullptr);
+      Q = X.leftCols(b);
     }
     Eigen::SelfAdjointEigenSolver<Mat> eig(T);
     std::vector<int> order(k);
@@ -113,6 +154,7 @@ KrylovSchurResult krylov_schur(ShiftInvert& op, const MassOperator& M, const Bas
       theta[i] = eig.eigenvalues()[order[i]];
     }
     const Mat FZ = F.transpose() * Z;  // b x keep: Ritz residuals in the basis Q
+    const Mat stored_Z = to_stored(L, Z);
     int converged = 0;
     while (converged < keep) {
       // The refined vector A y / theta has the residual ||r||_M / theta^2 (see eigen_residual).
@@ -130,7 +172,7 @@ KrylovSchurResult krylov_schur(ShiftInvert& op, const MassOperator& M, const Bas
     if (converged >= set.wanted || out.restarts >= set.max_restarts) {
       out.converged = converged >= set.wanted;
       const int count = std::max(converged, std::min(set.wanted, keep));
-      Mat G = V.leftCols(k) * Z.leftCols(count);
+      Mat G = V.leftCols(k) * stored_Z.leftCols(count);
       G.noalias() += Q * (FZ.leftCols(count) * theta.head(count).cwiseInverse().asDiagonal());
       project_out(G, {found}, M);  // Rayleigh-Ritz makes G M-orthonormal
       out.H = std::move(G);
@@ -138,9 +180,11 @@ KrylovSchurResult krylov_schur(ShiftInvert& op, const MassOperator& M, const Bas
       return out;
     }
     ++out.restarts;  // thick restart with the `keep` best Ritz vectors
-    multiply_in_place(V, k, Z);
+    multiply_in_place(V, k, stored_Z);
     T = theta.asDiagonal();
     F = FZ.transpose();
+    L = Mat::Identity(keep, keep);
+    E = Mat::Zero(keep, b);
     k = keep;
   }
 }

@@ -5,9 +5,12 @@
 // so Ritz pairs (theta, y = V z) of T have the residual A y - theta y = Q F^T z for free, and
 // A y / theta = y + Q F^T z / theta, one step of inverse iteration, is free too. Thick restarts
 // keep the `keep` Ritz vectors of largest |theta|. Each block step solves for a block of
-// right-hand sides and orthogonalises it against V by block Gram-Schmidt, twice, in three passes
-// over V (the subtraction of one pass fused with the projection of the next,
-// linalg/basis_sweep.h), then Cholesky QR within the block.
+// right-hand sides and orthogonalises it against V by block Gram-Schmidt, twice, in two passes
+// over V (the first pass's subtraction fused with the second's projection,
+// linalg/basis_sweep.h), then Cholesky QR within the block. The second pass's subtraction is
+// lagged (DCGS2, Swirydowicz et al. 2020): the block joins V as it is, V is kept as V_true L
+// with L unit upper triangular, and the next block's coefficients are corrected through the
+// Krylov relation, so no third pass is needed (one per restart cycle finishes the last block).
 #pragma once
 
 #include <functional>

@@ -43,6 +43,28 @@ TEST(BlockOrthogonalization, CholeskyQrKeepsTheProduct) {
   EXPECT_LE(R.triangularView<Eigen::StrictlyLower>().toDenseMatrix().cwiseAbs().maxCoeff(), 0.0);
 }
 
+// With a lag: W = W_true + V E, W_true M-orthogonal to V. Cholesky QR on W alone (no product
+// with V) makes W - V E M-orthonormal, keeps (W - V E) R = W_true and turns E along with W.
+TEST(BlockOrthogonalization, CholeskyQrWithALag) {
+  std::mt19937_64 rng(5);
+  const Sparse Ms = mass(600);
+  const MassOperator M(Ms);
+  const Mat V = orthonormal_block(600, 40, M, rng);
+  Mat W_true = detail::random_block(600, 8, rng);
+  detail::project_out(W_true, {V}, M);
+  const Mat E0 = 1e-4 * detail::random_block(40, 8, rng);
+  Mat W = W_true + V * E0, E = E0, R = Mat::Identity(8, 8);
+  ASSERT_TRUE(detail::cholesky_qr2(W, M, R, Mat(), &E));
+  const Mat Q = W - V * E;
+  EXPECT_LE(orthonormality(Q, Ms), 1e-13);
+  EXPECT_LE((V.transpose() * Ms * Q).cwiseAbs().maxCoeff(), 1e-13);
+  EXPECT_LE((Q * R - W_true).cwiseAbs().maxCoeff(), 1e-12);
+  // Without the lag the same block is orthonormalised with V's part in it.
+  Mat W2 = W_true + V * E0, R2 = Mat::Identity(8, 8);
+  ASSERT_TRUE(detail::cholesky_qr2(W2, M, R2));
+  EXPECT_GE((V.transpose() * Ms * W2).cwiseAbs().maxCoeff(), 1e-7);
+}
+
 // A block with planted dependent columns: Cholesky QR refuses it (W R unchanged), column
 // Gram-Schmidt hands exactly the dependent columns to the callback.
 TEST(BlockOrthogonalization, PlantedDependentColumns) {

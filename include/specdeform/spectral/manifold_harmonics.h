@@ -12,9 +12,9 @@
 // Solvers:
 //  - BlockKrylov (default): shift-invert block Krylov-Schur with thick restarts. K - sigma M is
 //    factored once per band with CHOLMOD, each step solves for a whole block of right-hand sides,
-//    and orthogonalises it against the basis by block Gram-Schmidt, twice, in three fused passes
-//    over the basis (the subtraction of one pass with the projection of the next) and Cholesky QR
-//    within the block. For large m the spectrum is computed band by band
+//    and orthogonalises it against the basis by block Gram-Schmidt, twice, in two fused passes
+//    over the basis (the subtraction of one pass with the projection of the next; the second
+//    pass's subtraction lagged into the next block, DCGS2-style) and Cholesky QR within the block. For large m the spectrum is computed band by band
 //    (interior shifts, LDL^T with one step of iterative refinement), each band deflated
 //    against the pairs already found. K's null space (the constants of each connected
 //    component) is known exactly and deflated from the start.
