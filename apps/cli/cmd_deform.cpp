@@ -107,6 +107,7 @@ void add_deform_command(CLI::App& app) {
         j["converged"] = arap.converged;
         j["clusters"] = deformer.rotation_clusters();
       }
+      j["detail_fold_zone"] = deformer.detail_fold_zone();
       j["timings"] = timings;
       j["constraint_error"] = {{"max", e.max}, {"rms", e.rms}};
       j["output"] = args->output;
@@ -118,6 +119,10 @@ void add_deform_command(CLI::App& app) {
       if (options.energy == DeformEnergy::Arap) {
         std::cout << "; ARAP " << arap.iterations << " iterations, last relative energy change "
                   << arap.relative_change << (arap.converged ? "" : " (not converged)");
+      }
+      if (deformer.detail_fold_zone() > 0) {
+        std::cout << "; the smooth base folded: details added as displacements on "
+                  << deformer.detail_fold_zone() << " faces";
       }
       if (constrained.free_pieces > 0) {
         std::cout << "; " << constrained.free_pieces << " pieces without handle or fixed vertex "

@@ -234,13 +234,16 @@ vertices held in place. A vertex may belong to one group only.)")
             r["clusters"] = d.deformer->rotation_clusters();
             r["free_pieces"] = d.deformer->free_pieces();
             r["constrained_piece_modes"] = d.deformer->constrained_piece_modes();
+            r["detail_fold_zone"] = d.deformer->detail_fold_zone();
             return r;
           },
           R"(The last solve: ARAP's iterations (of which L-BFGS steps: quasi_newton_steps), its energy
 and last relative change, whether it converged (the linear energy: 0 iterations, converged),
 the rotation clusters, and free_pieces (components without a handle or fixed vertex in the last
 selection: they follow the surface around them, or are held in place, as `unconstrained` says)
-and constrained_piece_modes (the basis's modes on each piece with a constrained vertex).)");
+and constrained_piece_modes (the basis's modes on each piece with a constrained vertex), and
+detail_fold_zone (faces where the details were added as displacements because the smooth base
+folded there).)");
 
   m.def("_read_scene", &read_scene_files, py::arg("path"), py::arg("mesh"),
         py::arg("transforms") = py::none());

@@ -13,6 +13,7 @@
 #include <Eigen/LU>
 
 #include "anchored_poisson.h"
+#include "fold_zone.h"
 #include "linalg/nearest_rotation.h"
 #include "linalg/parallel.h"
 #include "mesh/vertex_rings.h"
@@ -45,15 +46,11 @@ Eigen::Matrix3d ring_rotation(const Vertices& rest, const Vertices& deformed,
   return detail::nearest_rotation(A);
 }
 
-// [c - a, b - a, n] of triangle f, n the unit normal (zero for a degenerate triangle).
-Eigen::Matrix3d triangle_frame(const Vertices& V, const Faces& F, int f) {
-  const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
-  Eigen::Matrix3d m;
-  m.col(0) = c - a;
-  m.col(1) = b - a;
-  const Eigen::Vector3d n = (b - a).cross(c - a);
-  m.col(2) = n.norm() > 0.0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
-  return m;
+// The corners of triangle f (rows).
+Eigen::Matrix3d corners(const Vertices& V, const Faces& F, int f) {
+  Eigen::Matrix3d out;
+  for (int k = 0; k < 3; ++k) out.row(k) = V.row(F(f, k));
+  return out;
 }
 
 // Whether a base triangle carries a deformation gradient worth transferring: it is not
@@ -153,18 +150,6 @@ std::vector<int> transfer_donors(const TriangleMesh& detailed, const Vertices& b
   return donor;
 }
 
-// Q_f = A_f [grad phi_a; grad phi_b; grad phi_c] [grad x, grad y, grad z] of face f (rows:
-// its corners; zero for a degenerate face): the hat functions' gradients times the detailed
-// coordinates' gradients, area-weighted.
-Eigen::Matrix3d corner_gradients(const TriangleMesh& mesh, int f) {
-  Eigen::Matrix3d X;  // rows: the corners' positions
-  for (int k = 0; k < 3; ++k) X.row(k) = mesh.V.row(mesh.F(f, k));
-  const double area =
-      0.5 * Eigen::Vector3d(X.row(1) - X.row(0)).cross(Eigen::Vector3d(X.row(2) - X.row(0))).norm();
-  const Eigen::Matrix3d g = hat_gradients(mesh, f);
-  return area * g * (g.transpose() * X);
-}
-
 // A compressed row-major matrix from each row's (column, value) entries, rows i at
 // [start[i], start[i + 1]) of `entries`: each row sorted by column, the values of equal columns
 // summed in their order (as setFromTriplets sums them).
@@ -216,6 +201,11 @@ struct DetailReconstruction::Poisson {
                              // numbered as the factor)
   std::vector<int> anchors;  // the anchors' rows
   std::unique_ptr<detail::AnchoredPoisson> system;
+  // Where the deformed base folds (fold_zone.h): the detailed mesh and whether each face's
+  // right-hand side is its own base triangle's gradient (not a donor's or the identity).
+  std::unique_ptr<detail::FoldZone> folds;
+  RowMajor detailed;
+  std::vector<char> own;
   std::vector<int> order;  // row k is vertex order[k] of the mesh
   std::vector<int> rank;   // and vertex i of the mesh is row rank[i]
   Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> faces;  // sorted by their first row
@@ -224,6 +214,9 @@ struct DetailReconstruction::Poisson {
 
   void build(const TriangleMesh& detailed, const Vertices& base);  // all but the anchors
   void anchor(const std::vector<int>& vertices);                   // factors
+  // Adds to the right-hand side the difference the fold zone makes: on its faces the gradient
+  // of s' + (x - s) instead of the base's; returns the zone's size.
+  int correct_folds(const RowMajor& deformed, const RowMajor& normals, RowMajor& rhs) const;
 };
 
 // The background thread of a Transfer: builds the Poisson system, then factors the newest anchor
@@ -358,6 +351,7 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
       base_ = base;
       base_normals_ = vertex_normals(TriangleMesh{base, faces_});
       details_ = offset;
+      folds_ = std::make_unique<detail::FoldZone>(faces_, base);
       break;
     }
     case DetailMethod::Transfer:
@@ -401,8 +395,10 @@ void DetailReconstruction::Poisson::build(const TriangleMesh& detailed, const Ve
   detail::split_in_two(nf, [&](Eigen::Index begin, Eigen::Index end) {
     for (Eigen::Index g = begin; g < end; ++g) {
       const int f = face_order[g];
-      P[g] = corner_gradients(detailed, f);
-      if (donors[f] >= 0) P[g] *= triangle_frame(base, detailed.F, donors[f]).inverse().transpose();
+      P[g] = detail::corner_gradients(corners(detailed.V, detailed.F, f));
+      if (donors[f] >= 0) {
+        P[g] *= detail::triangle_frame(corners(base, detailed.F, donors[f])).inverse().transpose();
+      }
     }
   });
   // The rows of `edges` and `normals` by counting: three entries and one per corner.
@@ -444,6 +440,39 @@ void DetailReconstruction::Poisson::build(const TriangleMesh& detailed, const Ve
   P = {};
   p.edges = compressed_rows(n, n, edge_start, edges);
   p.normals = compressed_rows(n, nf, normal_start, normals);
+  RowMajor s(n, 3);
+  p.detailed.resize(n, 3);
+  for (int k = 0; k < n; ++k) {
+    p.detailed.row(k) = detailed.V.row(p.order[k]);
+    s.row(k) = base.row(p.order[k]);
+  }
+  p.own.resize(nf);
+  for (int g = 0; g < nf; ++g) p.own[g] = donors[face_order[g]] == face_order[g];
+  p.folds = std::make_unique<detail::FoldZone>(p.faces, std::move(s));
+}
+
+int DetailReconstruction::Poisson::correct_folds(const RowMajor& deformed, const RowMajor& normals,
+                                                 RowMajor& rhs) const {
+  const std::vector<int> zone = folds->find(deformed, normals);
+  for (const int f : zone) {
+    if (!own[f]) continue;
+    Eigen::Matrix3d x, s, s_deformed;
+    for (int k = 0; k < 3; ++k) {
+      x.row(k) = detailed.row(faces(f, k));
+      s.row(k) = folds->base().row(faces(f, k));
+      s_deformed.row(k) = deformed.row(faces(f, k));
+    }
+    const Eigen::Matrix3d rest_frame = detail::triangle_frame(x);
+    if (rest_frame.determinant() == 0.0) continue;
+    Eigen::Matrix3d base_frame = detail::triangle_frame(s_deformed);
+    base_frame.col(2) = normals.row(f).transpose();  // as the right-hand side has it
+    const Eigen::Matrix3d change =
+        detail::corner_gradients(x) *
+        (rest_frame.inverse().transpose() * detail::triangle_frame(s_deformed + x - s).transpose() -
+         detail::triangle_frame(s).inverse().transpose() * base_frame.transpose());
+    for (int k = 0; k < 3; ++k) rhs.row(faces(f, k)) += change.row(k);
+  }
+  return static_cast<int>(zone.size());
 }
 
 DetailReconstruction::~DetailReconstruction() = default;
@@ -503,6 +532,7 @@ void DetailReconstruction::on_ready(std::function<void()> callback) {
 
 Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& anchors) {
   applied_ = method_;
+  fold_zone_ = 0;
   switch (method_) {
     case DetailMethod::None:
       return s;
@@ -510,12 +540,19 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
       return s + details_;
     case DetailMethod::Frames: {
       const auto normals = vertex_normals(TriangleMesh{s, faces_});
+      const detail::RowVertices deformed = s;
+      const std::vector<int> zone =
+          folds_->find(deformed, detail::unit_face_normals(folds_->faces(), deformed));
+      fold_zone_ = static_cast<int>(zone.size());
+      std::vector<char> unturned(s.rows(), 0);
+      for (const int f : zone)
+        for (int k = 0; k < 3; ++k) unturned[faces_(f, k)] = 1;
       Vertices out(s.rows(), 3);
       detail::split_in_two(s.rows(), [&](Eigen::Index begin, Eigen::Index end) {
         for (Eigen::Index i = begin; i < end; ++i) {
           const int size = ring_start_[i + 1] - ring_start_[i];
           out.row(i) = s.row(i);
-          if (size == 0) {
+          if (size == 0 || unturned[i]) {
             out.row(i) += details_.row(i);
           } else {
             out.row(i) += (ring_rotation(base_, s, base_normals_, normals,
@@ -556,6 +593,7 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
     add_product(p.edges, positions.data(), begin, end, x.data());
     add_product(p.normals, normals.data(), begin, end, x.data());
   });
+  fold_zone_ = p.correct_folds(positions, normals, x);
   for (int i = 0; i < p.coupling.outerSize(); ++i)
     for (Sparse::InnerIterator it(p.coupling, i); it; ++it)
       x.row(it.row()) -= it.value() * anchors.row(i);

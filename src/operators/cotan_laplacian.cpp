@@ -105,8 +105,13 @@ Eigen::SparseMatrix<double> cotan_stiffness(const TriangleMesh& mesh) {
 }
 
 Eigen::Matrix3d hat_gradients(const TriangleMesh& mesh, int f) {
-  const Eigen::Vector3d p[3] = {mesh.V.row(mesh.F(f, 0)), mesh.V.row(mesh.F(f, 1)),
-                                mesh.V.row(mesh.F(f, 2))};
+  return hat_gradients(mesh.V.row(mesh.F(f, 0)), mesh.V.row(mesh.F(f, 1)),
+                       mesh.V.row(mesh.F(f, 2)));
+}
+
+Eigen::Matrix3d hat_gradients(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                              const Eigen::Vector3d& c) {
+  const Eigen::Vector3d p[3] = {a, b, c};
   if (is_degenerate_triangle(p[0], p[1], p[2])) return Eigen::Matrix3d::Zero();
   const Eigen::Vector3d normal = (p[1] - p[0]).cross(p[2] - p[0]);
   Eigen::Matrix3d g;

@@ -28,6 +28,10 @@
 // nearest sound triangle of its piece, or the identity where its piece has none (the piece
 // keeps its shape and follows its anchors); such a vertex keeps its offset as a displacement
 // (Frames).
+// Where the deformed base folds (a subspace too small for the bend a turning handle asks for),
+// the details are added as displacements on the fold's zone (src/deform/fold_zone.h): the
+// transfer takes the gradient of s' + (x - s) there, frames leave the offsets unturned;
+// fold_zone() says how many faces that was.
 // With s' = s every method returns x (to round-off).
 #pragma once
 
@@ -41,6 +45,10 @@
 #include "specdeform/mesh/triangle_mesh.h"
 
 namespace specdeform {
+
+namespace detail {
+class FoldZone;
+}  // namespace detail
 
 class DetailReconstruction {
  public:
@@ -69,17 +77,21 @@ class DetailReconstruction {
 
   DetailMethod method() const { return method_; }
   DetailMethod applied() const { return applied_; }  // by the last apply()
+  // Transfer and Frames: the faces of the last apply()'s fold zone (see above).
+  int fold_zone() const { return fold_zone_; }
 
   struct Poisson;  // the Transfer method's precomputed system
 
  private:
   struct Background;
   DetailMethod method_, applied_;
+  int fold_zone_ = 0;
   Faces faces_;
   Vertices details_;                    // x - s (Displacement, Frames)
   std::vector<int> ring_start_, ring_;  // Frames: each vertex's one-ring (empty: collapsed)
   Vertices base_;                       // Frames: s
   Eigen::Matrix<double, Eigen::Dynamic, 3> base_normals_;  // Frames: the vertex normals of s
+  std::unique_ptr<detail::FoldZone> folds_;                // Frames
   std::unique_ptr<Poisson> poisson_;                       // Transfer
   std::unique_ptr<Background> background_;                 // after poisson_: stopped before it goes
 };

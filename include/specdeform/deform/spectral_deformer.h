@@ -122,6 +122,9 @@ class SpectralDeformer {
   }
   // By the last solve() (options().detail before the first with single_solve).
   DetailMethod applied_detail() const { return details_ ? details_->applied() : options_.detail; }
+  // Faces where the last solve() added the details as displacements because the deformed base
+  // folded there (detail_reconstruction.h; 0 for the other methods).
+  int detail_fold_zone() const { return details_ ? details_->fold_zone() : 0; }
 
  private:
   TriangleMesh mesh_;

@@ -20,8 +20,10 @@ namespace specdeform {
 Eigen::SparseMatrix<double> cotan_stiffness(const TriangleMesh& mesh);
 
 // 3 x 3: row k the (constant) gradient on triangle f of the hat function of its corner k
-// (zero for a degenerate triangle).
+// (zero for a degenerate triangle); the same for the triangle (a, b, c).
 Eigen::Matrix3d hat_gradients(const TriangleMesh& mesh, int f);
+Eigen::Matrix3d hat_gradients(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                              const Eigen::Vector3d& c);
 
 // 3f x n: rows 3t, 3t+1, 3t+2 hold the x, y, z components of the (constant) gradient of a
 // piecewise-linear function on triangle t. With D = diag(area_t repeated three times),
