@@ -102,7 +102,7 @@ std::vector<int> FoldZone::find(const RowVertices& deformed, const RowVertices& 
   const int nf = static_cast<int>(faces_.rows());
   std::vector<int> folded[2];
   split_in_two(nf, [&](Eigen::Index begin, Eigen::Index end) {
-    std::vector<int>& out = folded[begin == 0 ? 0 : 1];
+    std::vector<int>& out = folded[end == nf ? 1 : 0];  // split_in_two: (half, nf), (0, half)
     for (Eigen::Index f = begin; f < end; ++f) {
       if (!agreed_[f]) continue;
       Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
