@@ -15,7 +15,9 @@
 // rings of edge neighbours. There the details are added as displacements, x'_d = s' + (x - s):
 // the transfer takes x'_d's deformation gradient instead of the base's, frames leave the
 // offsets unturned (detail_reconstruction.h). O(f) per frame to look for folds (none: nothing
-// changes), O(zone) beyond.
+// changes), O(zone) beyond. Measured on the camelhead's scene (default / frames folded faces):
+// ratio 1.5 with 0, 1, 2 rings 1/10, 0/6, 0/0; ratio 2 14/47, 9/34, 3/19; no growth 31/64,
+// 28/32, 12/32.
 #pragma once
 
 #include <vector>
@@ -42,7 +44,7 @@ RowVertices unit_face_normals(const FaceRows& faces, const RowVertices& V);
 class FoldZone {
  public:
   static constexpr double kStretchRatio = 1.5;
-  static constexpr int kRings = 1;
+  static constexpr int kRings = 2;
 
   // faces: f x 3 rows of `base`, the rest shape s (n x 3).
   FoldZone(FaceRows faces, RowVertices base);
