@@ -279,26 +279,6 @@ struct DetailReconstruction::Background {
 
 namespace {
 
-// Unit normals (b - a) x (c - a) of the faces [begin, end); zero where degenerate. Positions
-// and normals are row-major n x 3 and faces x 3.
-__attribute__((target_clones("avx2", "default"))) void unit_normals(const int* faces,
-                                                                    const double* positions,
-                                                                    int begin, int end,
-                                                                    double* normals) {
-  for (int f = begin; f < end; ++f) {
-    const double* a = positions + 3 * faces[3 * f];
-    const double* b = positions + 3 * faces[3 * f + 1];
-    const double* c = positions + 3 * faces[3 * f + 2];
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
-                         u[0] * v[1] - u[1] * v[0]};
-    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    const double scale = length > 0.0 ? 1.0 / length : 0.0;
-    for (int d = 0; d < 3; ++d) normals[3 * f + d] = n[d] * scale;
-  }
-}
-
 // out_i += sum_j A_ij x_j for the rows [begin, end) of A (CSR); x and out row-major, 3 columns.
 using RowSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 __attribute__((target_clones("avx2", "default"))) void add_product(const RowSparse& A,
@@ -541,8 +521,9 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
     case DetailMethod::Frames: {
       const auto normals = vertex_normals(TriangleMesh{s, faces_});
       const detail::RowVertices deformed = s;
-      const std::vector<int> zone =
-          folds_->find(deformed, detail::unit_face_normals(folds_->faces(), deformed));
+      detail::RowVertices face_normals;
+      detail::unit_face_normals(folds_->faces(), deformed, face_normals);
+      const std::vector<int> zone = folds_->find(deformed, face_normals);
       fold_zone_ = static_cast<int>(zone.size());
       std::vector<char> unturned(s.rows(), 0);
       for (const int f : zone)
@@ -580,14 +561,11 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
   RowMajor& normals = p.face_normals;
   RowMajor& x = p.x;  // the right-hand side, then the solution
   positions.resize(n, 3);
-  normals.resize(faces_.rows(), 3);
   x.resize(p.system->workspace_rows(), 3);
   detail::split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
     for (Eigen::Index k = begin; k < end; ++k) positions.row(k) = s.row(p.order[k]);
   });
-  detail::split_in_two(faces_.rows(), [&](Eigen::Index begin, Eigen::Index end) {
-    unit_normals(p.faces.data(), positions.data(), begin, end, normals.data());
-  });
+  detail::unit_face_normals(p.faces, positions, normals);
   detail::split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
     x.middleRows(begin, end - begin) = p.constant.middleRows(begin, end - begin);
     add_product(p.edges, positions.data(), begin, end, x.data());

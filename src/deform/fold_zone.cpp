@@ -38,6 +38,26 @@ double stretch_ratio(const Eigen::Matrix3d& rest, const Eigen::Matrix3d& deforme
                        : std::numeric_limits<double>::infinity();
 }
 
+// Unit normals (b - a) x (c - a) of the faces [begin, end); zero where degenerate. Positions
+// and normals are row-major n x 3 and faces x 3.
+__attribute__((target_clones("avx2", "default"))) void unit_normals(const int* faces,
+                                                                    const double* positions,
+                                                                    int begin, int end,
+                                                                    double* normals) {
+  for (int f = begin; f < end; ++f) {
+    const double* a = positions + 3 * faces[3 * f];
+    const double* b = positions + 3 * faces[3 * f + 1];
+    const double* c = positions + 3 * faces[3 * f + 2];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                         u[0] * v[1] - u[1] * v[0]};
+    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const double scale = length > 0.0 ? 1.0 / length : 0.0;
+    for (int d = 0; d < 3; ++d) normals[3 * f + d] = n[d] * scale;
+  }
+}
+
 }  // namespace
 
 Eigen::Matrix3d triangle_frame(const Eigen::Matrix3d& corners) {
@@ -57,13 +77,12 @@ Eigen::Matrix3d corner_gradients(const Eigen::Matrix3d& corners) {
   return area * g * (g.transpose() * corners);
 }
 
-RowVertices unit_face_normals(const FaceRows& faces, const RowVertices& V) {
-  RowVertices normals(faces.rows(), 3);
+void unit_face_normals(const FaceRows& faces, const RowVertices& V, RowVertices& normals) {
+  normals.resize(faces.rows(), 3);
   split_in_two(faces.rows(), [&](Eigen::Index begin, Eigen::Index end) {
-    for (Eigen::Index f = begin; f < end; ++f)
-      normals.row(f) = triangle_frame(corners_of(faces, V, static_cast<int>(f))).col(2).transpose();
+    unit_normals(faces.data(), V.data(), static_cast<int>(begin), static_cast<int>(end),
+                 normals.data());
   });
-  return normals;
 }
 
 FoldZone::FoldZone(FaceRows faces, RowVertices base)
@@ -88,7 +107,8 @@ FoldZone::FoldZone(FaceRows faces, RowVertices base)
       }
     }
   }
-  const RowVertices normals = unit_face_normals(faces_, base_);
+  RowVertices normals;
+  unit_face_normals(faces_, base_, normals);
   agreed_.assign(nf, 0);
   for (int f = 0; f < nf; ++f) {
     Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();

@@ -38,8 +38,9 @@ Eigen::Matrix3d triangle_frame(const Eigen::Matrix3d& corners);
 // degenerate). The transfer's right-hand side of a triangle of gradient S is Q S^T.
 Eigen::Matrix3d corner_gradients(const Eigen::Matrix3d& corners);
 
-// The unit normals (b - a) x (c - a) of the faces (f x 3; zero where degenerate).
-RowVertices unit_face_normals(const FaceRows& faces, const RowVertices& V);
+// The unit normals (b - a) x (c - a) of the faces (f x 3, in `normals`' memory; zero where
+// degenerate), on two threads.
+void unit_face_normals(const FaceRows& faces, const RowVertices& V, RowVertices& normals);
 
 class FoldZone {
  public:

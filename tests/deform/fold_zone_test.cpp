@@ -31,11 +31,13 @@ TEST(FoldZone, FindsAPlantedFoldAndNothingElse) {
   const Eigen::Affine3d rigid(Eigen::Translation3d(0.3, -0.2, 1.0) *
                               Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
   const RowVertices moved = (rigid * rest.transpose()).transpose();
-  EXPECT_TRUE(zone.find(moved, detail::unit_face_normals(faces, moved)).empty());
+  RowVertices normals;
+  detail::unit_face_normals(faces, moved, normals);
+  EXPECT_TRUE(zone.find(moved, normals).empty());
 
   RowVertices folded = rest;
   folded(centre(plane.V), 0) += 3.0 / 16;
-  const RowVertices normals = detail::unit_face_normals(faces, folded);
+  detail::unit_face_normals(faces, folded, normals);
   const std::vector<int> found = zone.find(folded, normals);
   std::vector<char> in(faces.rows(), 0);
   for (const int f : found) in[f] = 1;
