@@ -732,11 +732,15 @@ void EditorSession::solve_and_send(bool preview) {
   const FrameTimings& t = deformer.frame_timings();
   const ConstraintError e = deformer.constraint_error(view.preview ? shown : s.result);
   const ArapReport& arap = deformer.arap_report();
-  const FrameStats stats{
-      t.reduced_solve, t.inverse_transform,
-      t.detail,        t.total,
-      e.max,           e.rms,
-      arap.iterations, s.options.energy == DeformEnergy::Linear || arap.converged};
+  const FrameStats stats{t.reduced_solve,
+                         t.inverse_transform,
+                         t.detail,
+                         t.total,
+                         e.max,
+                         e.rms,
+                         arap.iterations,
+                         s.options.energy == DeformEnergy::Linear || arap.converged,
+                         deformer.detail_fold_zone()};
   const Vertices& positions = view.preview  ? shown
                               : s.base_view ? s.deformer->deformed_base()
                                             : s.result;

@@ -250,7 +250,8 @@ std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& 
   w.put(static_cast<uint32_t>(Tag::FrameResult));
   w.put(seq);
   w.put(static_cast<uint32_t>(n));
-  w.put(static_cast<uint32_t>((view.base ? 1 : 0) | (subset ? 2 : 0)));
+  w.put(static_cast<uint32_t>((view.base ? 1 : 0) | (subset ? 2 : 0) |
+                              (stats.fold_zone > 0 ? 4 : 0)));
   for (double ms : {stats.reduced_solve, stats.inverse_transform, stats.detail, stats.total}) {
     w.put(static_cast<float>(ms * 1e3));
   }

@@ -18,7 +18,8 @@
 //   5 scene        the same layout as 3, for a scene (.json, docs/scene.md)
 // Server -> browser
 //   101 mesh       u32 tag | u32 n | u32 triangles T | f32 positions (3 n) | u32 corners (3 T)
-//   102 frame      u32 tag | u32 seq | u32 n | u32 view (bit 0: smooth base, bit 1: preview) |
+//   102 frame      u32 tag | u32 seq | u32 n | u32 view (bit 0: smooth base, bit 1: preview,
+//                  bit 2: the smooth base folded, details added as displacements there) |
 //                  f32 reduced solve, inverse transform, detail, total (ms) |
 //                  f32 constraint error max, rms (over the bounding-box diagonal) |
 //                  u32 ARAP iterations | u32 1 if ARAP converged (or the energy is linear) |
@@ -106,6 +107,7 @@ struct FrameStats {
   double error_max = 0, error_rms = 0;
   int arap_iterations = 0;
   bool arap_converged = true;
+  int fold_zone = 0;  // faces where the details were added as displacements (a folded base)
 };
 
 // The tag of a binary message; throws InputError for one shorter than a tag.

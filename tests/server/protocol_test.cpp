@@ -126,6 +126,10 @@ TEST(Protocol, MeshAndFrameResultLayouts) {
   uint32_t view = 0;
   std::memcpy(&view, coarse.data() + 12, 4);
   EXPECT_EQ(view, 2u);
+  FrameStats folded;
+  folded.fold_zone = 12;
+  std::memcpy(&view, encode_frame_result(4, {}, folded, moved, m.V).data() + 12, 4);
+  EXPECT_EQ(view, 4u);  // bit 2: details added as displacements where the base folded
   const Vertices back = decode_frame_positions(coarse, m.V, &preview);
   EXPECT_NEAR(back(0, 2), moved(2, 2), 0.5 / 32767);
   EXPECT_NEAR(back(1, 0), moved(1, 0), 0.5 / 32767);

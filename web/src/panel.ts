@@ -448,7 +448,8 @@ export class Panel {
       ['selection', s.server ? `${(1000 * s.server.selection_seconds).toFixed(1)} ms` : '–'],
       ['solve (server)', f ? `${f.ms.total.toFixed(1)} ms` : '–'],
       ['· reduced / inverse / detail', f
-        ? `${f.ms.reducedSolve.toFixed(1)} / ${f.ms.inverseTransform.toFixed(1)} / ${f.ms.detail.toFixed(1)}` : '–'],
+        ? `${f.ms.reducedSolve.toFixed(1)} / ${f.ms.inverseTransform.toFixed(1)} / ${f.ms.detail.toFixed(1)}${
+          f.foldZone ? ' (the smooth base folded: details added as displacements there)' : ''}` : '–'],
       ['ARAP iterations', r?.settings.energy === 'arap' && f
         ? `${f.arap.iterations}${f.arap.converged ? '' : ' (not converged)'} · ${r.arap_clusters} clusters` : '–'],
       ['drag → drawn (median)', stats.latencies.length ? `${median(stats.latencies.slice(-30)).toFixed(0)} ms` : '–'],

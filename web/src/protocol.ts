@@ -123,6 +123,7 @@ export interface FrameResult {
   seq: number;
   baseView: boolean;
   preview: boolean; // positions of the preview's vertices only
+  foldZone: boolean; // the smooth base folded: details added as displacements there
   ms: { reducedSolve: number; inverseTransform: number; detail: number; total: number };
   error: { max: number; rms: number };
   arap: { iterations: number; converged: boolean };
@@ -233,6 +234,7 @@ export function decodeFrameResult(buffer: ArrayBuffer): FrameResult {
     seq: u[1],
     baseView: (u[3] & 1) !== 0,
     preview: (u[3] & 2) !== 0,
+    foldZone: (u[3] & 4) !== 0,
     ms: { reducedSolve: f[0], inverseTransform: f[1], detail: f[2], total: f[3] },
     error: { max: f[4], rms: f[5] },
     arap: { iterations: u[10], converged: u[11] === 1 },
