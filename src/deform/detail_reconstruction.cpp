@@ -94,14 +94,7 @@ std::vector<int> transfer_donors(const TriangleMesh& detailed, const Vertices& b
     }
   });
   if (all_sound) return donor;
-  const int n = detailed.num_vertices();
-  std::vector<int> start(n + 1, 0), incident(3 * size_t(nf));  // each vertex's faces, ascending
-  for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) ++start[detailed.F(f, k) + 1];
-  for (int i = 0; i < n; ++i) start[i + 1] += start[i];
-  std::vector<int> fill(start.begin(), start.end() - 1);
-  for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) incident[fill[detailed.F(f, k)]++] = f;
+  const detail::VertexFaces incident = detail::vertex_faces(detailed.F, detailed.num_vertices());
   // Calls visit(g) for each face g sharing an edge with f (f too), in the order above.
   const auto for_each_neighbour = [&](int f, auto&& visit) {
     std::array<std::pair<int, int>, 3> edges;
@@ -111,10 +104,10 @@ std::vector<int> transfer_donors(const TriangleMesh& detailed, const Vertices& b
     }
     std::sort(edges.begin(), edges.end());
     for (const auto& [a, b] : edges) {
-      const int* p = incident.data() + start[a];
-      const int* p_end = incident.data() + start[a + 1];
-      const int* q = incident.data() + start[b];
-      const int* q_end = incident.data() + start[b + 1];
+      const int* p = incident.face.data() + incident.start[a];
+      const int* p_end = incident.face.data() + incident.start[a + 1];
+      const int* q = incident.face.data() + incident.start[b];
+      const int* q_end = incident.face.data() + incident.start[b + 1];
       while (p != p_end && q != q_end) {  // the faces on both ends, ascending
         if (*p < *q) {
           ++p;

@@ -9,6 +9,7 @@
 #include <Eigen/LU>
 
 #include "linalg/parallel.h"
+#include "mesh/vertex_rings.h"
 #include "specdeform/operators/cotan_laplacian.h"
 
 namespace specdeform::detail {
@@ -88,20 +89,13 @@ void unit_face_normals(const FaceRows& faces, const RowVertices& V, RowVertices&
 FoldZone::FoldZone(FaceRows faces, RowVertices base)
     : faces_(std::move(faces)), base_(std::move(base)) {
   const int nf = static_cast<int>(faces_.rows());
-  const int n = static_cast<int>(base_.rows());
-  std::vector<int> start(n + 1, 0), incident(3 * size_t(nf));  // each vertex's faces
-  for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) ++start[faces_(f, k) + 1];
-  for (int i = 0; i < n; ++i) start[i + 1] += start[i];
-  std::vector<int> fill(start.begin(), start.end() - 1);
-  for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) incident[fill[faces_(f, k)]++] = f;
+  const VertexFaces incident = vertex_faces(faces_, static_cast<int>(base_.rows()));
   neighbours_ = FaceRows::Constant(nf, 3, -1);
   for (int f = 0; f < nf; ++f) {
     for (int k = 0; k < 3; ++k) {
       const int a = faces_(f, k), b = faces_(f, (k + 1) % 3);
-      for (int e = start[a]; e < start[a + 1] && neighbours_(f, k) < 0; ++e) {
-        const int g = incident[e];
+      for (int e = incident.start[a]; e < incident.start[a + 1] && neighbours_(f, k) < 0; ++e) {
+        const int g = incident.face[e];
         if (g != f && (faces_(g, 0) == b || faces_(g, 1) == b || faces_(g, 2) == b))
           neighbours_(f, k) = g;
       }
