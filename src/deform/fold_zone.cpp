@@ -105,11 +105,16 @@ FoldZone::FoldZone(FaceRows faces, RowVertices base)
   unit_face_normals(faces_, base_, normals);
   agreed_.assign(nf, 0);
   for (int f = 0; f < nf; ++f) {
-    Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
-    for (int k = 0; k < 3; ++k)
-      if (neighbours_(f, k) >= 0) sum += normals.row(neighbours_(f, k));
+    const Eigen::RowVector3d sum = neighbour_normals(normals, f);
     agreed_[f] = sum.norm() > 0.0 && normals.row(f).dot(sum) > 0.5 * sum.norm();
   }
+}
+
+Eigen::RowVector3d FoldZone::neighbour_normals(const RowVertices& normals, Eigen::Index f) const {
+  Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+  for (int k = 0; k < 3; ++k)
+    if (neighbours_(f, k) >= 0) sum += normals.row(neighbours_(f, k));
+  return sum;
 }
 
 std::vector<int> FoldZone::find(const RowVertices& deformed, const RowVertices& normals) const {
@@ -118,11 +123,8 @@ std::vector<int> FoldZone::find(const RowVertices& deformed, const RowVertices& 
   split_in_two(nf, [&](Eigen::Index begin, Eigen::Index end) {
     std::vector<int>& out = folded[end == nf ? 1 : 0];  // split_in_two: (half, nf), (0, half)
     for (Eigen::Index f = begin; f < end; ++f) {
-      if (!agreed_[f]) continue;
-      Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
-      for (int k = 0; k < 3; ++k)
-        if (neighbours_(f, k) >= 0) sum += normals.row(neighbours_(f, k));
-      if (normals.row(f).dot(sum) < 0.0) out.push_back(static_cast<int>(f));
+      if (agreed_[f] && normals.row(f).dot(neighbour_normals(normals, f)) < 0.0)
+        out.push_back(static_cast<int>(f));
     }
   });
   std::vector<int> zone = std::move(folded[0]);

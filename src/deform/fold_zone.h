@@ -58,6 +58,9 @@ class FoldZone {
   const RowVertices& base() const { return base_; }
 
  private:
+  // The sum of the unit normals of face f's edge neighbours.
+  Eigen::RowVector3d neighbour_normals(const RowVertices& normals, Eigen::Index f) const;
+
   FaceRows faces_;
   FaceRows neighbours_;  // per face, the face across each edge (-1: none)
   RowVertices base_;
