@@ -89,12 +89,11 @@ KrylovSchurResult krylov_schur(ShiftInvert& op, const MassOperator& M, const Bas
       // can be normalised by Cholesky QR alone. A Q_true = A Q - A V_true E = A Q - V_true
       // (T E) - Q_true (F^T E) by the relation: a part in the span of V_true, which the
       // projections take out anyway, so only its coefficients change.
+      X.leftCols(b) = solved;
       if (near.cols() > 0) {
-        W = solved;
+        W = X.leftCols(b);
         project_out(W, {near}, M);
         X.leftCols(b) = W;
-      } else {
-        X.leftCols(b) = solved;
       }
       M.project(V, k + b, X, nullptr, &D1, nullptr);
       Mat C1 = to_true(Lx, D1, b);
