@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <numeric>
+#include <span>
 #include <sstream>
 #include <unordered_set>
 
@@ -109,30 +110,40 @@ LoadedMesh build_mesh(PolygonSoup soup, const std::string& name) {
       info.face_to_file.push_back(p);
     }
   }
-  // Triangles on the same three vertices as an earlier one: sorted by their sorted corners, each
-  // run of equal ones keeps its first.
+  // Triangles on the same three vertices as an earlier one: bucketed by their smallest corner
+  // (by counting, in file order), each bucket sorted by the other two, each run of equal ones
+  // keeping its first. Sorting every face's key took 0.35 s for 1.4M faces; the buckets hold a
+  // vertex's few faces.
   {
-    const size_t count = tris.size() / 3;
-    std::vector<std::array<int, 3>> key(count);
-    for (size_t f = 0; f < count; ++f) {
-      key[f] = {tris[3 * f], tris[3 * f + 1], tris[3 * f + 2]};
-      std::sort(key[f].begin(), key[f].end());
+    const int count = static_cast<int>(tris.size() / 3);
+    std::vector<int> start(nv + 1, 0);
+    std::vector<uint64_t> rest(count);  // the two larger corners, packed
+    for (int f = 0; f < count; ++f) {
+      std::array<int, 3> corner{tris[3 * f], tris[3 * f + 1], tris[3 * f + 2]};
+      std::sort(corner.begin(), corner.end());
+      ++start[corner[0] + 1];
+      rest[f] = uint64_t(uint32_t(corner[1])) << 32 | uint32_t(corner[2]);
     }
-    std::vector<size_t> order(count);
-    std::iota(order.begin(), order.end(), size_t{0});
-    std::sort(order.begin(), order.end(),
-              [&](size_t a, size_t b) { return key[a] != key[b] ? key[a] < key[b] : a < b; });
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    std::vector<std::pair<uint64_t, int>> bucketed(count);  // (rest, face)
+    for (int f = 0; f < count; ++f) {
+      const int smallest = std::min({tris[3 * f], tris[3 * f + 1], tris[3 * f + 2]});
+      bucketed[start[smallest]++] = {rest[f], f};
+    }
     std::vector<char> keep(count, 1);
-    for (size_t i = 1; i < count; ++i) {
-      if (key[order[i]] == key[order[i - 1]]) keep[order[i]] = 0;
+    for (int b = 0, first = 0; b < nv; first = start[b++]) {
+      const auto bucket = std::span(bucketed).subspan(first, start[b] - first);
+      std::sort(bucket.begin(), bucket.end());
+      for (size_t i = 1; i < bucket.size(); ++i)
+        if (bucket[i].first == bucket[i - 1].first) keep[bucket[i].second] = 0;
     }
-    size_t kept = 0;
-    for (size_t f = 0; f < count; ++f) {
+    int kept = 0;
+    for (int f = 0; f < count; ++f) {
       if (!keep[f]) continue;
       for (int c = 0; c < 3; ++c) tris[3 * kept + c] = tris[3 * f + c];
       info.face_to_file[kept++] = info.face_to_file[f];
     }
-    info.duplicate_faces = static_cast<int>(count - kept);
+    info.duplicate_faces = count - kept;
     tris.resize(3 * kept);
     info.face_to_file.resize(kept);
   }

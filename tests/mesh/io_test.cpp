@@ -299,6 +299,20 @@ TEST(MeshIo, DuplicateFacesAreDropped) {
   EXPECT_EQ(m.info.duplicate_faces, 2);
   EXPECT_EQ(m.info.face_to_file, (std::vector<int>{0, 1}));
   EXPECT_EQ(m.mesh.F.row(1), Eigen::RowVector3i(1, 3, 2));
+
+  // A fan of 40 faces around vertex 0, then every third of them again, turned: the repeats are
+  // found among the many faces of one corner and the first of each pair is kept.
+  std::string obj;
+  for (int k = 0; k <= 40; ++k)
+    obj += "v " + std::to_string(k) + " " + std::to_string(k % 3) + " 1\n";
+  for (int k = 1; k <= 40; ++k)
+    obj += "f 1 " + std::to_string(k + 1) + " " + std::to_string(k % 40 + 2) + "\n";
+  for (int k = 39; k >= 1; k -= 3)
+    obj += "f " + std::to_string(k % 40 + 2) + " 1 " + std::to_string(k + 1) + "\n";
+  const LoadedMesh fan = parse(obj, MeshFormat::Obj);
+  EXPECT_EQ(fan.mesh.num_faces(), 40);
+  EXPECT_EQ(fan.info.duplicate_faces, 13);
+  EXPECT_EQ(fan.info.face_to_file.back(), 39);
 }
 
 TEST(MeshIo, ClearErrors) {
