@@ -16,15 +16,19 @@ using Sparse = Eigen::SparseMatrix<double>;
 
 }  // namespace
 
-AnchoredPoisson::AnchoredPoisson(const Sparse& K)
-    : K_(K), anchored_(K.rows(), 0), position_(K.rows()), common_(new cholmod_common) {
+AnchoredPoisson::AnchoredPoisson(const Sparse& K, Solves solves)
+    : solves_(solves),
+      K_(K),
+      anchored_(K.rows(), 0),
+      position_(K.rows()),
+      common_(new cholmod_common) {
   cholmod_start(common_);
   // Factored supernodal (BLAS-3: half the time of a simplicial factorisation at 692k vertices);
   // turned into the simplicial LDL^T that rowadd and rowdel work on at the first update.
   common_->supernodal = CHOLMOD_SUPERNODAL;
   common_->final_ll = 0;
   common_->nmethods = 1;
-  common_->method[0].ordering = CHOLMOD_METIS;
+  common_->method[0].ordering = solves == Solves::One ? CHOLMOD_AMD : CHOLMOD_METIS;
   Sparse lower = K_.triangularView<Eigen::Lower>();
   cholmod_sparse A = Eigen::viewAsCholmod(lower);
   A.stype = -1;
@@ -100,11 +104,12 @@ void AnchoredPoisson::set_anchors(const std::vector<int>& anchors) {
   // scratch beyond max(16, n / 2000) changes (measured, the editor's paint stroke of 1,355
   // vertices: 6.6 s by updates).
   const Eigen::Index changes = static_cast<Eigen::Index>(add.size() + remove.size());
-  if (!factored_ || changes > std::max<Eigen::Index>(16, K_.rows() / 2000)) {
+  if (!factored_ || solves_ == Solves::One ||
+      changes > std::max<Eigen::Index>(16, K_.rows() / 2000)) {
     anchored_ = std::move(next);
     factorize();
     factored_ = true;
-    solver_.assign(factor_);
+    if (solves_ == Solves::Many) solver_.assign(factor_);
     return;
   }
   if (factor_->is_super) {  // both forms held for a moment
@@ -122,6 +127,23 @@ void AnchoredPoisson::set_anchors(const std::vector<int>& anchors) {
     throw SolverError("deformation transfer: updating the Poisson factorisation failed");
   }
   solver_.assign(factor_);
+}
+
+int AnchoredPoisson::workspace_rows() const {
+  return solves_ == Solves::One ? static_cast<int>(K_.rows()) : solver_.workspace_rows();
+}
+
+void AnchoredPoisson::solve_in_place(double* x) const {
+  if (solves_ == Solves::Many) return solver_.solve_in_place(x, 3);
+  // CHOLMOD's solve with L alone (the right-hand side is in the factor's order already).
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+  Eigen::Map<RowMajor> rows(x, K_.rows(), 3);
+  Eigen::MatrixX3d columns = rows;
+  cholmod_dense b = Eigen::viewAsCholmod(columns);
+  cholmod_dense* solved = cholmod_solve(CHOLMOD_LDLt, factor_, &b, common_);
+  if (solved == nullptr) throw SolverError("deformation transfer: the Poisson solve failed");
+  rows = Eigen::Map<const Eigen::MatrixX3d>(static_cast<const double*>(solved->x), K_.rows(), 3);
+  cholmod_free_dense(&solved, common_);
 }
 
 }  // namespace specdeform::detail

@@ -205,8 +205,9 @@ struct DetailReconstruction::Poisson {
   // Per-frame buffers, kept: a fresh allocation of this size costs its page faults each frame.
   RowMajor positions, face_normals, x;
 
-  void build(const TriangleMesh& detailed, const Vertices& base);  // all but the anchors
-  void anchor(const std::vector<int>& vertices);                   // factors
+  // All but the anchors; once: for one anchor set and one solve.
+  void build(const TriangleMesh& detailed, const Vertices& base, bool once);
+  void anchor(const std::vector<int>& vertices);  // factors
   // Adds to the right-hand side the difference the fold zone makes: on its faces the gradient
   // of s' + (x - s) instead of the base's; returns the zone's size.
   int correct_folds(const RowMajor& deformed, const RowMajor& normals, RowMajor& rhs) const;
@@ -219,7 +220,7 @@ struct DetailReconstruction::Background {
   void run(Poisson& poisson, TriangleMesh mesh, Vertices base) {
     bool built = true;  // else `error` says why, for good
     try {
-      poisson.build(mesh, base);
+      poisson.build(mesh, base, false);
     } catch (...) {
       std::lock_guard lock(mutex);
       error = std::current_exception();
@@ -293,7 +294,7 @@ __attribute__((target_clones("avx2", "default"))) void add_product(const RowSpar
 }  // namespace
 
 DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const Vertices& base,
-                                           DetailMethod method, bool background)
+                                           DetailMethod method, TransferSolves solves)
     : method_(method), applied_(method), faces_(detailed.F) {
   if (base.rows() != detailed.V.rows()) {
     throw InputError("details: the base has " + std::to_string(base.rows()) +
@@ -329,8 +330,8 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
     }
     case DetailMethod::Transfer:
       poisson_ = std::make_unique<Poisson>();
-      if (!background) {
-        poisson_->build(detailed, base);
+      if (solves != TransferSolves::Background) {
+        poisson_->build(detailed, base, solves == TransferSolves::Once);
         break;
       }
       details_ = offset;
@@ -343,11 +344,14 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
   }
 }
 
-void DetailReconstruction::Poisson::build(const TriangleMesh& detailed, const Vertices& base) {
+void DetailReconstruction::Poisson::build(const TriangleMesh& detailed, const Vertices& base,
+                                          bool once) {
   Poisson& p = *this;
   const int nf = detailed.num_faces();
   const int n = detailed.num_vertices();
-  p.system = std::make_unique<detail::AnchoredPoisson>(cotan_stiffness(detailed));
+  using Solves = detail::AnchoredPoisson::Solves;
+  p.system = std::make_unique<detail::AnchoredPoisson>(cotan_stiffness(detailed),
+                                                       once ? Solves::One : Solves::Many);
   p.order = p.system->order();
   p.rank.resize(n);
   for (int k = 0; k < n; ++k) p.rank[p.order[k]] = k;

@@ -100,8 +100,9 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
   }
   setup_.reduced_system = clock.lap();
   if (!options_.single_solve) {
-    details_ = std::make_unique<DetailReconstruction>(mesh_, base_, options_.detail,
-                                                      options_.background_transfer);
+    details_ = std::make_unique<DetailReconstruction>(
+        mesh_, base_, options_.detail,
+        options_.background_transfer ? TransferSolves::Background : TransferSolves::Repeated);
     setup_.detail_factorization = clock.lap();
   }
   deformed_base_ = base_;
@@ -203,7 +204,8 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
     reduced_.reset();
     spatial_.reset();
     arap_.reset();
-    details_ = std::make_unique<DetailReconstruction>(mesh_, base_, options_.detail);
+    details_ =
+        std::make_unique<DetailReconstruction>(mesh_, base_, options_.detail, TransferSolves::Once);
     details_->set_anchors(constrained_.vertices);
     deferred = setup_.detail_factorization = clock.lap();
   }

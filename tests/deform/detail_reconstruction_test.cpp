@@ -165,7 +165,7 @@ TEST(DetailReconstruction, BackgroundTransferSwitchesOverToTheSameResult) {
   const Vertices expected = now.apply(turned, targets(second));
 
   std::atomic<int> calls = 0;
-  DetailReconstruction later(mesh, base, DetailMethod::Transfer, true);
+  DetailReconstruction later(mesh, base, DetailMethod::Transfer, TransferSolves::Background);
   later.on_ready([&] { ++calls; });
   EXPECT_TRUE(later.ready());  // no anchors asked for yet
   later.set_anchors(first);

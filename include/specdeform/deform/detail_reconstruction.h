@@ -50,11 +50,17 @@ namespace detail {
 class FoldZone;
 }  // namespace detail
 
+// How a Transfer's Poisson system is used: factored for each anchor set (updated where the set
+// changes a little) with a two-thread solve per frame (Repeated), the same built and factored on
+// a thread of its own (Background, see above; the thread starts in the constructor), or one
+// anchor set solved once (Once: deform(), the command line's deform; an ordering for one
+// solve, src/deform/anchored_poisson.h).
+enum class TransferSolves { Repeated, Background, Once };
+
 class DetailReconstruction {
  public:
-  // background: Transfer only, see above; the thread starts here.
   DetailReconstruction(const TriangleMesh& detailed, const Vertices& base, DetailMethod method,
-                       bool background = false);
+                       TransferSolves solves = TransferSolves::Repeated);
   ~DetailReconstruction();  // waits for a background factorisation under way
   DetailReconstruction(const DetailReconstruction&) = delete;
   DetailReconstruction& operator=(const DetailReconstruction&) = delete;
