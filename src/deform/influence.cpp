@@ -1,46 +1,30 @@
 #include "specdeform/deform/influence.h"
 
 #include <cmath>
-#include <functional>
-#include <limits>
-#include <queue>
 #include <string>
 #include <vector>
 
-#include "mesh/vertex_rings.h"
+#include "mesh/graph_distance.h"
 #include "specdeform/exceptions.h"
 
 namespace specdeform {
 
 Eigen::VectorXd handle_distances(const TriangleMesh& mesh, const Selection& selection) {
   const int n = mesh.num_vertices();
-  const detail::VertexRings rings = detail::vertex_rings(mesh);
-  Eigen::VectorXd distance = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
-  using Entry = std::pair<double, int>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+  std::vector<int> sources;
   for (const std::vector<int>& group : selection.handles) {
     for (const int v : group) {
       if (v < 0 || v >= n) {
         throw InputError("influence: handle vertex " + std::to_string(v) + " is out of range");
       }
-      distance[v] = 0.0;
-      queue.emplace(0.0, v);
+      sources.push_back(v);
     }
   }
-  while (!queue.empty()) {
-    const auto [d, v] = queue.top();
-    queue.pop();
-    if (d > distance[v]) continue;
-    for (int e = rings.start[v]; e < rings.start[v + 1]; ++e) {
-      const int w = rings.neighbour[e];
-      const double through = d + (mesh.V.row(w) - mesh.V.row(v)).norm();
-      if (through < distance[w]) {
-        distance[w] = through;
-        queue.emplace(through, w);
-      }
-    }
-  }
-  return distance;
+  std::vector<float> distance(n, detail::kFar);
+  detail::DistanceHeap heap;
+  detail::pruned_dijkstra(detail::edge_graph(mesh), sources, detail::kFar, distance, heap,
+                          [](int, float) {});
+  return Eigen::Map<const Eigen::VectorXf>(distance.data(), n).cast<double>();
 }
 
 Selection limit_influence(const TriangleMesh& mesh, const Selection& selection, double radius) {

@@ -5,11 +5,10 @@
 // seed over the support radius rho = support * r (r the sampling's covering radius: every vertex
 // lies within r of a seed), normalised to a partition of unity:
 //     P_ij = psi(d_j(i) / rho) / sum_k psi(d_k(i) / rho)      (n x N, every row sums to 1).
-// Farthest-point sampling seeds every connected component before it places a second seed
-// anywhere, so with N >= the number of components P 1 = 1: the constants of each component are
-// in the span exactly. Cost: one pruned Dijkstra per seed, O(n log n) in all for the sampling and
-// O(n c log n) for the functions, c the vertices' average number of covering functions (about
-// 2 support^2); the functions are built on two threads.
+// Farthest-point sampling (mesh/graph_distance.h) seeds every connected component, so P 1 = 1:
+// the constants of each component are in the span exactly. Cost: one pruned Dijkstra per seed,
+// O(n log n) in all for the sampling and O(n c log n) for the functions, c the vertices' average
+// number of covering functions (about 2 support^2); the functions are built on two threads.
 #pragma once
 
 #include <Eigen/Core>
@@ -24,7 +23,8 @@ struct CoarseSpace {
 };
 
 // lengths: n x n, symmetric, the length of edge ij at (i, j) (K's pattern; the diagonal is
-// ignored). samples: N, at least 1 (fewer if n is smaller). support: rho / r, > 1.
+// ignored). samples: N, at least 1 (fewer if n is smaller, more if there are more connected
+// components). support: rho / r, > 1.
 CoarseSpace partition_of_unity(const Eigen::SparseMatrix<double>& lengths, int samples,
                                double support);
 

@@ -49,18 +49,5 @@ TEST(CoarseSpace, PartitionOfUnityOverEveryComponent) {
   }
 }
 
-// Farthest-point sampling spreads the seeds: on a sphere every vertex lies within the covering
-// radius of a seed, and that radius is about what N equal discs need.
-TEST(CoarseSpace, CoveringRadiusOfEvenSamples) {
-  const TriangleMesh sphere = make_icosphere(4);  // 2,562 vertices, area 4 pi
-  const Sparse K = cotan_stiffness(sphere);
-  const int N = 100;
-  const detail::CoarseSpace space =
-      detail::partition_of_unity(detail::edge_lengths(K, sphere.V), N, 2.5);
-  const double disc = std::sqrt(4.0 / N);  // pi r^2 N = 4 pi
-  EXPECT_GT(space.radius, 0.8 * disc);
-  EXPECT_LT(space.radius, 1.6 * disc);
-}
-
 }  // namespace
 }  // namespace specdeform

@@ -2,8 +2,9 @@
 // `radius` from every handle vertex, along the surface, join the fixed set, so that the handles
 // move only the surface near them; the deformation energy makes the transition to the held part
 // smooth. Distances are shortest paths along the mesh's edges (Dijkstra from all handle vertices
-// at once, edge lengths of the mesh's positions): at most a few percent above the geodesic
-// distance on a well-shaped mesh. Only the pieces that hold a handle vertex are limited.
+// at once, edge lengths of the mesh's positions, in single precision): at most a few percent
+// above the geodesic distance on a well-shaped mesh. Only the pieces that hold a handle vertex are
+// limited.
 #pragma once
 
 #include <Eigen/Core>
