@@ -41,15 +41,19 @@ struct Accumulator {
   std::vector<int> touched;
 };
 
+// The symmetric matrix of which the triplets give the upper triangle.
 Sparse symmetric(const Triplets& halves0, const Triplets& halves1, int N) {
   Triplets all;
-  all.reserve(halves0.size() + halves1.size());
-  all.insert(all.end(), halves0.begin(), halves0.end());
-  all.insert(all.end(), halves1.begin(), halves1.end());
+  all.reserve(2 * (halves0.size() + halves1.size()));
+  for (const Triplets* half : {&halves0, &halves1}) {
+    for (const Eigen::Triplet<double>& t : *half) {
+      all.push_back(t);
+      if (t.row() != t.col()) all.emplace_back(t.col(), t.row(), t.value());
+    }
+  }
   Sparse C(N, N);
   C.setFromTriplets(all.begin(), all.end());
-  const Sparse transposed = C.transpose();
-  return 0.5 * (C + transposed);
+  return C;
 }
 
 }  // namespace
@@ -69,8 +73,8 @@ std::array<Sparse, 2> galerkin_products(const Sparse& K, const Sparse& M, const 
         for (Sparse::InnerIterator a(M, p.index()); a; ++a)
           applied.add(static_cast<int>(a.index()), 0.0, a.value() * p.value());
       }
-      applied.drain([&](int l, double k, double m) {  // P^T (K P_j), P^T (M P_j)
-        for (RowSparse::InnerIterator q(P_rows, l); q; ++q)
+      applied.drain([&](int l, double k, double m) {  // rows c <= j of P^T (K P_j), P^T (M P_j)
+        for (RowSparse::InnerIterator q(P_rows, l); q && q.index() <= j; ++q)
           projected.add(static_cast<int>(q.index()), q.value() * k, q.value() * m);
       });
       projected.drain([&](int c, double k, double m) {

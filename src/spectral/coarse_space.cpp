@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <vector>
 
 #include "linalg/parallel.h"
@@ -21,52 +20,10 @@ double bump(double t) {
   return t >= 1.0 ? 0.0 : std::exp(-4.0 * t * t) - std::exp(-4.0);
 }
 
-}  // namespace
-
-CoarseSpace partition_of_unity(const Sparse& lengths, int samples, double support) {
-  const int n = static_cast<int>(lengths.rows());
-  const EdgeGraph graph = edge_graph(lengths);
-  const Sampling farthest = farthest_points(graph, std::clamp(samples, 1, n));
-  const std::vector<int>& seeds = farthest.seeds;
-  CoarseSpace out;
-  out.radius = farthest.covering_radius();
-  const float rho = static_cast<float>(support * out.radius);
-
-  // Column j of P: seed j's bump, by a Dijkstra limited to rho (its entries in the order
-  // settled). The seeds are taken in the order of their vertices, which a breadth-first
-  // numbering (linalg/locality_order.h) keeps near each other, so that one search finds much of
-  // the graph the last one fetched (692k vertices: 0.69 against 0.94 s in the sampling's order);
-  // split between two threads.
-  const int N = static_cast<int>(seeds.size());
-  std::vector<int> in_vertex_order(N);
-  std::iota(in_vertex_order.begin(), in_vertex_order.end(), 0);
-  std::ranges::sort(in_vertex_order, {}, [&](int j) { return seeds[j]; });
-  std::vector<std::vector<std::pair<int, double>>> columns(N);
-  const auto bumps = [&](int begin, int end) {
-    std::vector<float> distance(n, kFar);
-    DistanceHeap heap;
-    for (int k = begin; k < end; ++k) {
-      const int j = in_vertex_order[k];
-      std::vector<std::pair<int, double>>& column = columns[j];
-      pruned_dijkstra(graph, std::span(&seeds[j], 1), rho, distance, heap, [&](int i, float d) {
-        column.emplace_back(i, rho > 0.0f ? bump(double{d} / rho) : 1.0);
-      });
-      for (const auto& [i, value] : column) distance[i] = kFar;
-      std::erase_if(column, [](const auto& entry) { return entry.second <= 0.0; });
-    }
-  };
-  run_pair([&] { bumps(0, N / 2); }, [&] { bumps(N / 2, N); });
-  // Row-major by counting (each row's entries in column order), each entry divided by its
-  // row's sum (the partition of unity).
-  Eigen::SparseMatrix<double, Eigen::RowMajor>& R = out.rows;
-  R.resize(n, N);
-  std::vector<int> fill(n + 1, 0);
-  for (const auto& column : columns)
-    for (const auto& entry : column) ++fill[entry.first + 1];
-  for (int i = 0; i < n; ++i) fill[i + 1] += fill[i];
-  R.resizeNonZeros(fill[n]);
-  std::copy(fill.begin(), fill.end(), R.outerIndexPtr());
-  for (int j = 0; j < N; ++j) {
+// Columns [begin, end) into R's rows, entry by entry at fill[row]++ (then freed).
+void place(std::vector<std::vector<std::pair<int, double>>>& columns, int begin, int end,
+           std::vector<int>& fill, Eigen::SparseMatrix<double, Eigen::RowMajor>& R) {
+  for (int j = begin; j < end; ++j) {
     for (const auto& [i, value] : columns[j]) {
       const int at = fill[i]++;
       R.innerIndexPtr()[at] = j;
@@ -74,12 +31,69 @@ CoarseSpace partition_of_unity(const Sparse& lengths, int samples, double suppor
     }
     columns[j] = {};
   }
-  for (int i = 0; i < n; ++i) {
-    const double sum = R.row(i).sum();
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(R, i); it; ++it) {
-      it.valueRef() /= sum;
+}
+
+}  // namespace
+
+CoarseSpace partition_of_unity(const Sparse& lengths, int samples, double support) {
+  const int n = static_cast<int>(lengths.rows());
+  const EdgeGraph graph = edge_graph(lengths);
+  const Sampling farthest = farthest_points(graph, std::clamp(samples, 1, n));
+  CoarseSpace out;
+  out.radius = farthest.covering_radius();
+  const float rho = static_cast<float>(support * out.radius);
+
+  // Column j of P: the bump of the j-th seed in the order of their vertices, by a Dijkstra
+  // limited to rho (its entries in the order settled). A breadth-first numbering
+  // (linalg/locality_order.h) keeps seeds of nearby numbers near each other, so that one search
+  // finds much of the graph the last one fetched (692k vertices: 0.69 against 0.94 s in the
+  // sampling's order). The columns split between two threads, each counting its entries per row.
+  std::vector<int> seed = farthest.seeds;
+  std::ranges::sort(seed);
+  const int N = static_cast<int>(seed.size());
+  std::vector<std::vector<std::pair<int, double>>> columns(N);
+  std::vector<int> count[2] = {std::vector<int>(n, 0), std::vector<int>(n, 0)};
+  const auto bumps = [&](int begin, int end, std::vector<int>& rows) {
+    std::vector<float> distance(n, kFar);
+    DistanceHeap heap;
+    for (int j = begin; j < end; ++j) {
+      std::vector<std::pair<int, double>>& column = columns[j];
+      pruned_dijkstra(graph, std::span(&seed[j], 1), rho, distance, heap, [&](int i, float d) {
+        column.emplace_back(i, rho > 0.0f ? bump(double{d} / rho) : 1.0);
+      });
+      for (const auto& [i, value] : column) distance[i] = kFar;
+      std::erase_if(column, [](const auto& entry) { return entry.second <= 0.0; });
+      for (const auto& entry : column) ++rows[entry.first];
     }
-  }
+  };
+  run_pair([&] { bumps(0, N / 2, count[0]); }, [&] { bumps(N / 2, N, count[1]); });
+  // Row-major by counting: each row's entries of the first half of the columns, then of the
+  // second (so in column order), each thread placing its own; then each entry divided by its
+  // row's sum (the partition of unity).
+  Eigen::SparseMatrix<double, Eigen::RowMajor>& R = out.rows;
+  R.resize(n, N);
+  int* start = R.outerIndexPtr();
+  start[0] = 0;
+  for (int i = 0; i < n; ++i) start[i + 1] = start[i] + count[0][i] + count[1][i];
+  R.resizeNonZeros(start[n]);
+  run_pair(
+      [&] {
+        for (int i = 0; i < n; ++i) count[0][i] = start[i];
+        place(columns, 0, N / 2, count[0], R);
+      },
+      [&] {
+        for (int i = 0; i < n; ++i)
+          count[1][i] = start[i + 1] - count[1][i];  // after the first half
+        place(columns, N / 2, N, count[1], R);
+      });
+  split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
+    double* value = R.valuePtr();
+    for (Eigen::Index i = begin; i < end; ++i) {
+      double sum = 0.0;
+      for (int e = start[i]; e < start[i + 1]; ++e) sum += value[e];
+      for (int e = start[i]; e < start[i + 1]; ++e) value[e] /= sum;
+    }
+  });
   out.prolongation = R;  // Eigen's transposition is the same counting
   return out;
 }

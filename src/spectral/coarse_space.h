@@ -17,7 +17,8 @@
 namespace specdeform::detail {
 
 struct CoarseSpace {
-  Eigen::SparseMatrix<double> prolongation;           // P, n x N, rows sum to 1
+  Eigen::SparseMatrix<double> prolongation;  // P, n x N, rows sum to 1, columns in the order
+                                             // of their seeds' vertices
   Eigen::SparseMatrix<double, Eigen::RowMajor> rows;  // P again, row-major
   double radius = 0.0;                                // r, in the units of the edge lengths
 };

@@ -22,18 +22,18 @@ bool PairErrors::within(double tolerance, double floor_factor, double factor) co
 namespace {
 
 constexpr int kColumns = 16;
-using RowSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+using Rows = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>>;
 
 // Sums over the rows [begin, end) of d_i (K h - l M h)_i^2 and, with kFloors,
 // d_i (|K||h| + |l| |M||h|)_i^2 for the kColumns columns of `block` (n x kColumns, row-major),
 // added to residual2 and floor2.
 template <bool kFloors>
-[[gnu::always_inline]] inline void block_sums(const RowSparse& K, const RowSparse& M,
-                                              const double* block, const double* l,
-                                              const double* d_inv, Eigen::Index begin,
-                                              Eigen::Index end, double* residual2, double* floor2) {
+[[gnu::always_inline]] inline void block_sums(const Rows& K, const Rows& M, const double* block,
+                                              const double* l, const double* d_inv,
+                                              Eigen::Index begin, Eigen::Index end,
+                                              double* residual2, double* floor2) {
   // Row i of A times the block into ah, and of |A| times |block| into ah_abs (kFloors).
-  const auto row_product = [block](const RowSparse& A, Eigen::Index i, double* ah, double* ah_abs) {
+  const auto row_product = [block](const Rows& A, Eigen::Index i, double* ah, double* ah_abs) {
     for (int e = A.outerIndexPtr()[i]; e < A.outerIndexPtr()[i + 1]; ++e) {
       const double v = A.valuePtr()[e], a = std::abs(v);
       const double* h = block + kColumns * A.innerIndexPtr()[e];
@@ -59,12 +59,12 @@ template <bool kFloors>
 }
 
 __attribute__((target_clones("avx2", "default"))) void sums_with_floors(
-    const RowSparse& K, const RowSparse& M, const double* block, const double* l,
-    const double* d_inv, Eigen::Index begin, Eigen::Index end, double* residual2, double* floor2) {
+    const Rows& K, const Rows& M, const double* block, const double* l, const double* d_inv,
+    Eigen::Index begin, Eigen::Index end, double* residual2, double* floor2) {
   block_sums<true>(K, M, block, l, d_inv, begin, end, residual2, floor2);
 }
 
-__attribute__((target_clones("avx2", "default"))) void sums(const RowSparse& K, const RowSparse& M,
+__attribute__((target_clones("avx2", "default"))) void sums(const Rows& K, const Rows& M,
                                                             const double* block, const double* l,
                                                             const double* d_inv, Eigen::Index begin,
                                                             Eigen::Index end, double* residual2,
@@ -80,7 +80,18 @@ PairErrors pair_errors(const Sparse& K, const Sparse& M, const Mat& H, const Vec
                        bool floors) {
   using Block = Eigen::Matrix<double, Eigen::Dynamic, kColumns, Eigen::RowMajor>;
   using Sums = Eigen::Array<double, kColumns, 1>;
-  const RowSparse Kr = K, Mr = M;
+  if (!K.isCompressed() || !M.isCompressed()) {
+    Sparse Kc = K, Mc = M;
+    Kc.makeCompressed();
+    Mc.makeCompressed();
+    return pair_errors(Kc, Mc, H, lambda, floors);
+  }
+  // K and M are symmetric: their compressed columns, read as rows, are their rows (no copy).
+  const auto rows = [](const Sparse& A) {
+    return Rows(A.rows(), A.cols(), A.nonZeros(), A.outerIndexPtr(), A.innerIndexPtr(),
+                A.valuePtr());
+  };
+  const Rows Kr = rows(K), Mr = rows(M);
   const double area = M.sum();
   const Vec d_inv = (M * Vec::Ones(M.rows())).cwiseInverse();
   const Eigen::Index n = H.rows();

@@ -22,7 +22,7 @@ struct PairErrors {
   bool within(double tolerance, double floor_factor, double factor = 1.0) const;
 };
 
-// floors = false: the floors are left 0 (an approximate basis, whose residuals are orders of
+// K and M symmetric. floors = false: the floors are left 0 (an approximate basis, whose residuals are orders of
 // magnitude above them: half the work).
 PairErrors pair_errors(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M,
                        const Eigen::MatrixXd& H, const Eigen::VectorXd& lambda, bool floors = true);
