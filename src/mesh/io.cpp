@@ -10,7 +10,6 @@
 #include <fstream>
 #include <numeric>
 #include <span>
-#include <sstream>
 #include <unordered_set>
 
 #include "polygon_soup.h"
@@ -195,10 +194,13 @@ LoadedMesh read_mesh(const std::filesystem::path& path) {
   if (std::filesystem::is_directory(path, ec)) throw InputError(path.string() + ": is a directory");
   std::ifstream file(path, std::ios::binary);
   if (!file) throw InputError(path.string() + ": cannot open file");
-  std::ostringstream bytes;
-  bytes << file.rdbuf();
+  std::string bytes;  // reserved when the size is known (not for a pipe): no regrowth
+  if (const auto size = std::filesystem::file_size(path, ec); !ec) bytes.reserve(size);
+  std::vector<char> chunk(1 << 20);
+  while (file.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || file.gcount() > 0)
+    bytes.append(chunk.data(), static_cast<size_t>(file.gcount()));
   if (file.bad()) throw InputError(path.string() + ": read error");
-  return read_mesh_from_memory(bytes.str(), format, path.string());
+  return read_mesh_from_memory(bytes, format, path.string());
 }
 
 MeshReadInfo identity_read_info(const TriangleMesh& mesh) {

@@ -98,6 +98,34 @@ TEST(MeshIo, ObjForms) {
   EXPECT_EQ(m.info.face_to_file, (std::vector<int>{0, 0, 1, 2}));
 }
 
+// A file large enough to be read in two halves: a strip of quads, each with its two new
+// vertices just before it and negative indices (back into the first half where the split falls),
+// comments and texture lines between; the same mesh as the strip written in one piece. An error
+// in the second half names the face of the whole file.
+TEST(MeshIo, LargeObjInTwoHalves) {
+  constexpr int kQuads = 160'000;  // about 10 MB
+  std::string text = "# strip\nv 0 0 0\nv 0 1 0\n";
+  for (int q = 1; q <= kQuads; ++q) {
+    const std::string x = std::to_string(q);
+    text += "v " + x + " 0 0\n  v\t" + x + " 1 0.5\nvt 0 0\n# quad " + x + "\nf -4 -2 -1 -3\n";
+  }
+  ASSERT_GT(text.size(), size_t{9} << 20);
+  const LoadedMesh m = parse(text, MeshFormat::Obj);
+  ASSERT_EQ(m.mesh.num_vertices(), 2 * kQuads + 2);
+  ASSERT_EQ(m.info.file_faces, kQuads);
+  for (int q = 0; q < kQuads; q += 997) {
+    EXPECT_EQ(m.mesh.V.row(2 * q + 2), Eigen::RowVector3d(q + 1, 0, 0));
+    EXPECT_EQ(m.mesh.F.row(2 * q), Eigen::RowVector3i(2 * q, 2 * q + 2, 2 * q + 3)) << q;
+  }
+  std::string broken = text;
+  broken.replace(broken.rfind("f -4"), 4, "f -x");
+  expect_error(broken, MeshFormat::Obj,
+               "bad face corner '-x' in face " + std::to_string(kQuads - 1));
+  broken = text;
+  broken.replace(broken.rfind("f -4"), 4, "f 9999999");
+  expect_error(broken, MeshFormat::Obj, "only " + std::to_string(2 * kQuads + 2) + " vertices");
+}
+
 // Two quads that share two sides (a b c d and c b a e, as the beast has them): fanned from their
 // first corners both would take the diagonal a c, one triangle twice back to back; the second is
 // fanned from b instead, and the mesh stays manifold and consistently oriented.
