@@ -13,6 +13,11 @@
 namespace specdeform {
 
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
+  write_file_atomically(path, std::span(&bytes, 1));
+}
+
+void write_file_atomically(const std::filesystem::path& path,
+                           std::span<const std::string_view> parts) {
   const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
   std::string tmp_name = ".";
   tmp_name += path.filename().string();
@@ -28,14 +33,16 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view b
     ::unlink(tmp.c_str());
     throw InputError(path.string() + ": " + what + ": " + reason);
   };
-  size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t wrote = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (wrote < 0) {
-      if (errno == EINTR) continue;
-      fail("cannot write");
+  for (const std::string_view bytes : parts) {
+    size_t done = 0;
+    while (done < bytes.size()) {
+      const ssize_t wrote = ::write(fd, bytes.data() + done, bytes.size() - done);
+      if (wrote < 0) {
+        if (errno == EINTR) continue;
+        fail("cannot write");
+      }
+      done += static_cast<size_t>(wrote);
     }
-    done += static_cast<size_t>(wrote);
   }
   if (::fchmod(fd, 0644) != 0 || ::fsync(fd) != 0) fail("cannot write");
   if (::close(fd) != 0) {

@@ -3,11 +3,15 @@
 #pragma once
 
 #include <filesystem>
+#include <span>
 #include <string_view>
 
 namespace specdeform {
 
 // Throws InputError (naming the path) if the file cannot be written.
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+// The same for the concatenation of `parts`, written one after the other.
+void write_file_atomically(const std::filesystem::path& path,
+                           std::span<const std::string_view> parts);
 
 }  // namespace specdeform

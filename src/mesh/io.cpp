@@ -12,6 +12,7 @@
 #include <span>
 #include <unordered_set>
 
+#include "linalg/parallel.h"
 #include "polygon_soup.h"
 #include "specdeform/atomic_file.h"
 #include "specdeform/exceptions.h"
@@ -244,48 +245,73 @@ void append_le(std::string& s, T v) {
   s.append(b, sizeof(T));
 }
 
-std::string encode_obj(const TriangleMesh& m) {
-  std::string s = "# written by specdeform\n";
-  for (int i = 0; i < m.num_vertices(); ++i) {
-    s += 'v';
-    for (int k = 0; k < 3; ++k) {
-      s += ' ';
-      append_number(s, m.V(i, k));
-    }
-    s += '\n';
-  }
-  for (int f = 0; f < m.num_faces(); ++f) {
-    s += 'f';
-    for (int k = 0; k < 3; ++k) {
-      s += ' ';
-      append_number(s, m.F(f, k) + 1);
-    }
-    s += '\n';
-  }
-  return s;
+// A text format's vertex and face lines, each list encoded in two halves at once (the first
+// halves on one thread, the second on the other): the parts of the file after its header, in
+// order (692k vertices, OBJ: 0.41 -> 0.2-0.26 s with the write).
+template <typename VertexLine, typename FaceLine>
+std::vector<std::string> text_lines(const TriangleMesh& m, const VertexLine& vertex_line,
+                                    const FaceLine& face_line) {
+  std::vector<std::string> part(4);  // vertices, first and second half; then faces
+  const auto encode = [&](int half) {
+    const auto lines = [&](int count, std::string& s, const auto& line) {
+      const int begin = half * (count / 2), end = half == 0 ? count / 2 : count;
+      s.reserve(static_cast<size_t>(end - begin) * 40);
+      for (int i = begin; i < end; ++i) line(s, i);
+    };
+    lines(m.num_vertices(), part[half], vertex_line);
+    lines(m.num_faces(), part[2 + half], face_line);
+  };
+  detail::run_pair([&] { encode(0); }, [&] { encode(1); });
+  return part;
 }
 
-std::string encode_off(const TriangleMesh& m) {
-  std::string s = "OFF\n";
-  append_number(s, m.num_vertices());
-  s += ' ';
-  append_number(s, m.num_faces());
-  s += " 0\n";
-  for (int i = 0; i < m.num_vertices(); ++i) {
-    for (int k = 0; k < 3; ++k) {
-      append_number(s, m.V(i, k));
-      s += k < 2 ? ' ' : '\n';
-    }
-  }
-  for (int f = 0; f < m.num_faces(); ++f) {
-    s += '3';
-    for (int k = 0; k < 3; ++k) {
-      s += ' ';
-      append_number(s, m.F(f, k));
-    }
-    s += '\n';
-  }
-  return s;
+std::vector<std::string> encode_obj(const TriangleMesh& m) {
+  std::vector<std::string> parts = text_lines(
+      m,
+      [&](std::string& s, int i) {
+        s += 'v';
+        for (int k = 0; k < 3; ++k) {
+          s += ' ';
+          append_number(s, m.V(i, k));
+        }
+        s += '\n';
+      },
+      [&](std::string& s, int f) {
+        s += 'f';
+        for (int k = 0; k < 3; ++k) {
+          s += ' ';
+          append_number(s, m.F(f, k) + 1);
+        }
+        s += '\n';
+      });
+  parts.insert(parts.begin(), "# written by specdeform\n");
+  return parts;
+}
+
+std::vector<std::string> encode_off(const TriangleMesh& m) {
+  std::vector<std::string> parts = text_lines(
+      m,
+      [&](std::string& s, int i) {
+        for (int k = 0; k < 3; ++k) {
+          append_number(s, m.V(i, k));
+          s += k < 2 ? ' ' : '\n';
+        }
+      },
+      [&](std::string& s, int f) {
+        s += '3';
+        for (int k = 0; k < 3; ++k) {
+          s += ' ';
+          append_number(s, m.F(f, k));
+        }
+        s += '\n';
+      });
+  std::string header = "OFF\n";
+  append_number(header, m.num_vertices());
+  header += ' ';
+  append_number(header, m.num_faces());
+  header += " 0\n";
+  parts.insert(parts.begin(), std::move(header));
+  return parts;
 }
 
 std::string encode_ply(const TriangleMesh& m) {
@@ -317,24 +343,33 @@ std::string encode_stl(const TriangleMesh& m) {
   return s;
 }
 
-}  // namespace
-
-std::string encode_mesh(const TriangleMesh& mesh, MeshFormat format) {
+// The file's bytes, in parts to be concatenated.
+std::vector<std::string> encode_parts(const TriangleMesh& mesh, MeshFormat format) {
   switch (format) {
     case MeshFormat::Obj:
       return encode_obj(mesh);
     case MeshFormat::Off:
       return encode_off(mesh);
     case MeshFormat::Ply:
-      return encode_ply(mesh);
+      return {encode_ply(mesh)};
     case MeshFormat::Stl:
-      return encode_stl(mesh);
+      return {encode_stl(mesh)};
   }
   return {};
 }
 
+}  // namespace
+
+std::string encode_mesh(const TriangleMesh& mesh, MeshFormat format) {
+  std::string out;
+  for (const std::string& part : encode_parts(mesh, format)) out += part;
+  return out;
+}
+
 void write_mesh(const std::filesystem::path& path, const TriangleMesh& mesh) {
-  write_file_atomically(path, encode_mesh(mesh, mesh_format_from_path(path)));
+  const std::vector<std::string> parts = encode_parts(mesh, mesh_format_from_path(path));
+  const std::vector<std::string_view> views(parts.begin(), parts.end());
+  write_file_atomically(path, views);
 }
 
 }  // namespace specdeform
