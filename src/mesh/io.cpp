@@ -252,14 +252,17 @@ template <typename VertexLine, typename FaceLine>
 std::vector<std::string> text_lines(const TriangleMesh& m, const VertexLine& vertex_line,
                                     const FaceLine& face_line) {
   std::vector<std::string> part(4);  // vertices, first and second half; then faces
+  // Reserved for the usual line (three shortest round-trip doubles; three indices of n's
+  // digits): a string that regrows holds two copies for a moment.
+  const size_t vertex_bytes = 64, face_bytes = 3 * std::to_string(m.num_vertices()).size() + 6;
   const auto encode = [&](int half) {
-    const auto lines = [&](int count, std::string& s, const auto& line) {
+    const auto lines = [&](int count, size_t bytes, std::string& s, const auto& line) {
       const int begin = half * (count / 2), end = half == 0 ? count / 2 : count;
-      s.reserve(static_cast<size_t>(end - begin) * 40);
+      s.reserve(static_cast<size_t>(end - begin) * bytes);
       for (int i = begin; i < end; ++i) line(s, i);
     };
-    lines(m.num_vertices(), part[half], vertex_line);
-    lines(m.num_faces(), part[2 + half], face_line);
+    lines(m.num_vertices(), vertex_bytes, part[half], vertex_line);
+    lines(m.num_faces(), face_bytes, part[2 + half], face_line);
   };
   detail::run_pair([&] { encode(0); }, [&] { encode(1); });
   return part;
