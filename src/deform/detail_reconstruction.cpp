@@ -205,9 +205,9 @@ struct DetailReconstruction::Poisson {
   // Per-frame buffers, kept: a fresh allocation of this size costs its page faults each frame.
   RowMajor positions, face_normals, x;
 
-  // All but the anchors; once: for one anchor set and one solve.
-  void build(const TriangleMesh& detailed, const Vertices& base, bool once);
-  void anchor(const std::vector<int>& vertices);  // factors
+  void build(const TriangleMesh& detailed, const Vertices& base,
+             detail::AnchoredPoisson::Solves solves);  // all but the anchors
+  void anchor(const std::vector<int>& vertices);       // factors
   // Adds to the right-hand side the difference the fold zone makes: on its faces the gradient
   // of s' + (x - s) instead of the base's; returns the zone's size.
   int correct_folds(const RowMajor& deformed, const RowMajor& normals, RowMajor& rhs) const;
@@ -220,7 +220,7 @@ struct DetailReconstruction::Background {
   void run(Poisson& poisson, TriangleMesh mesh, Vertices base) {
     bool built = true;  // else `error` says why, for good
     try {
-      poisson.build(mesh, base, false);
+      poisson.build(mesh, base, detail::AnchoredPoisson::Solves::Many);
     } catch (...) {
       std::lock_guard lock(mutex);
       error = std::current_exception();
@@ -331,7 +331,9 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
     case DetailMethod::Transfer:
       poisson_ = std::make_unique<Poisson>();
       if (solves != TransferSolves::Background) {
-        poisson_->build(detailed, base, solves == TransferSolves::Once);
+        poisson_->build(detailed, base,
+                        solves == TransferSolves::Once ? detail::AnchoredPoisson::Solves::One
+                                                       : detail::AnchoredPoisson::Solves::Many);
         break;
       }
       details_ = offset;
@@ -345,13 +347,11 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
 }
 
 void DetailReconstruction::Poisson::build(const TriangleMesh& detailed, const Vertices& base,
-                                          bool once) {
+                                          detail::AnchoredPoisson::Solves solves) {
   Poisson& p = *this;
   const int nf = detailed.num_faces();
   const int n = detailed.num_vertices();
-  using Solves = detail::AnchoredPoisson::Solves;
-  p.system = std::make_unique<detail::AnchoredPoisson>(cotan_stiffness(detailed),
-                                                       once ? Solves::One : Solves::Many);
+  p.system = std::make_unique<detail::AnchoredPoisson>(cotan_stiffness(detailed), solves);
   p.order = p.system->order();
   p.rank.resize(n);
   for (int k = 0; k < n; ++k) p.rank[p.order[k]] = k;

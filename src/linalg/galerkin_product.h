@@ -3,10 +3,10 @@
 // (spectral/multilevel.cpp). Column by column: the sparse vectors K P_j and M P_j (P's column
 // j), then the rows c <= j of P^T times both in one walk over P's rows (the upper triangle:
 // the rest by symmetry), each accumulated in a dense array with a list of the entries touched.
-// The columns are split between two threads. Work: about
-// nnz(P) (a + c) for a the entries per column of K and M and c per row of P, and O(n + N)
-// memory per thread besides the results; Eigen's general sparse products, which sort and prune
-// each intermediate, took about 7 times as long on a 692k-vertex mesh.
+// The columns are split between two threads. Work: about nnz(P) (a + c) for a the entries per
+// column of K and M and c per row of P, and O(n + N) memory per thread besides the results;
+// Eigen's general sparse products, which sort and prune each intermediate, took about 7 times
+// as long on a 692k-vertex mesh.
 #pragma once
 
 #include <array>
