@@ -1,8 +1,7 @@
 #include "mesh/graph_distance.h"
 
 #include <algorithm>
-
-#include "mesh/vertex_rings.h"
+#include <numeric>
 
 namespace specdeform::detail {
 
@@ -20,16 +19,27 @@ EdgeGraph edge_graph(const Eigen::SparseMatrix<double>& lengths) {
 }
 
 EdgeGraph edge_graph(const TriangleMesh& mesh) {
-  const VertexRings rings = vertex_rings(mesh);
+  std::vector<int> same(mesh.num_vertices());
+  std::iota(same.begin(), same.end(), 0);
+  return edge_graph(vertex_rings(mesh), mesh.V, same);
+}
+
+EdgeGraph edge_graph(const VertexRings& rings, const Vertices& V, std::span<const int> new_number) {
+  const int n = static_cast<int>(V.rows());
+  std::vector<int> old_number(n);
+  for (int i = 0; i < n; ++i) old_number[new_number[i]] = i;
   EdgeGraph g;
-  g.start = rings.start;
-  g.arcs.resize(rings.neighbour.size());
-  for (int i = 0; i < mesh.num_vertices(); ++i) {
+  g.start.resize(n + 1);
+  g.arcs.reserve(rings.neighbour.size());
+  for (int k = 0; k < n; ++k) {
+    const int i = old_number[k];
+    g.start[k] = static_cast<int>(g.arcs.size());
     for (int e = rings.start[i]; e < rings.start[i + 1]; ++e) {
       const int j = rings.neighbour[e];
-      g.arcs[e] = {j, static_cast<float>((mesh.V.row(i) - mesh.V.row(j)).norm())};
+      g.arcs.push_back({new_number[j], static_cast<float>((V.row(i) - V.row(j)).norm())});
     }
   }
+  g.start[n] = static_cast<int>(g.arcs.size());
   return g;
 }
 

@@ -23,6 +23,7 @@
 
 #include <Eigen/Sparse>
 
+#include "mesh/vertex_rings.h"
 #include "specdeform/mesh/triangle_mesh.h"
 
 namespace specdeform::detail {
@@ -44,6 +45,9 @@ struct EdgeGraph {
 EdgeGraph edge_graph(const Eigen::SparseMatrix<double>& lengths);
 // The mesh's edges with their Euclidean lengths.
 EdgeGraph edge_graph(const TriangleMesh& mesh);
+// The same from the mesh's rings and positions V, vertex i numbered new_number[i] in the graph
+// (a permutation of 0 .. n-1).
+EdgeGraph edge_graph(const VertexRings& rings, const Vertices& V, std::span<const int> new_number);
 
 // A min-heap of (distance, vertex), each entry one integer: a non-negative float's bits order as
 // its value does, so the distance's bits above the vertex's order the entries by distance.

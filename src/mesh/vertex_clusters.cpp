@@ -12,16 +12,13 @@ VertexClusters vertex_clusters(const TriangleMesh& mesh, int count) {
   const int n = mesh.num_vertices();
   VertexClusters out;
   if (n == 0) return out;
-  // The sampling on the mesh renumbered breadth first (neighbours close in memory: a subdivided
-  // mesh numbers them far apart), its labels put back.
+  // The sampling on the edge graph renumbered breadth first (neighbours close in memory: a
+  // subdivided mesh numbers them far apart), its labels put back.
   const detail::VertexRings rings = detail::vertex_rings(mesh);
   const detail::Permutation P =
       detail::breadth_first_order(n, rings.start.data(), rings.neighbour.data());
-  TriangleMesh ordered{P * mesh.V, mesh.F};
-  for (Eigen::Index f = 0; f < ordered.F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) ordered.F(f, k) = P.indices()[ordered.F(f, k)];
-  const detail::Sampling s =
-      detail::farthest_points(detail::edge_graph(ordered), std::max(count, 1));
+  const detail::Sampling s = detail::farthest_points(
+      detail::edge_graph(rings, mesh.V, std::span(P.indices().data(), n)), std::max(count, 1));
   out.count = static_cast<int>(s.seeds.size());
   out.label.resize(n);
   for (int i = 0; i < n; ++i) out.label[i] = s.owner[P.indices()[i]];

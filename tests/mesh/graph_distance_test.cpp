@@ -67,6 +67,21 @@ TEST(GraphDistance, DijkstraFromSeveralSources) {
   }
 }
 
+// A renumbered graph is the same graph: each vertex's distances come out at its new number.
+TEST(GraphDistance, RenumberedGraph) {
+  for (const test::CorpusMesh& c : test::corpus()) {
+    const int n = c.mesh.num_vertices();
+    std::vector<int> reversed(n);
+    for (int i = 0; i < n; ++i) reversed[i] = n - 1 - i;
+    const detail::EdgeGraph plain = detail::edge_graph(c.mesh);
+    const detail::EdgeGraph turned =
+        detail::edge_graph(detail::vertex_rings(c.mesh), c.mesh.V, reversed);
+    const std::vector<double> expected = reference_distances(plain, {0});
+    const std::vector<double> got = reference_distances(turned, {n - 1});
+    for (int i = 0; i < n; ++i) EXPECT_EQ(got[n - 1 - i], expected[i]) << c.name << " " << i;
+  }
+}
+
 // Every component seeded, each vertex owned by a nearest seed, the covering radius the largest
 // distance; on a sphere the seeds spread about as N equal discs would.
 TEST(GraphDistance, FarthestPoints) {
