@@ -22,8 +22,11 @@ const sd::MeshReadInfo& mesh() {
   static const sd::MeshReadInfo info = [] {
     sd::MeshReadInfo i;
     i.file_vertices = sd::make_icosphere(0).V;
-    for (int v = 0; v < kFileVertices; ++v)
-      if (v != 0 && v != 5) i.vertex_to_file.push_back(v);
+    for (int v = 0; v < kFileVertices; ++v) {
+      const bool kept = v != 0 && v != 5;
+      i.file_to_vertex.push_back(kept ? static_cast<int>(i.vertex_to_file.size()) : -1);
+      if (kept) i.vertex_to_file.push_back(v);
+    }
     return i;
   }();
   return info;

@@ -222,8 +222,10 @@ void add_compare_command(CLI::App& app) {
         std::string file = m.name;
         std::replace_if(
             file.begin(), file.end(), [](char c) { return !std::isalnum(c); }, '_');
-        write_mesh(std::filesystem::path(args->output) / (file + ".obj"),
-                   to_file_order(loaded.mesh.info, m.result, mesh.F));
+        write_result(
+            std::filesystem::path(args->output) /
+                (file + std::filesystem::path(loaded.mesh.file->name).extension().string()),
+            loaded.mesh, m.result);
       }
     }
     args->tables.write(rows, table);

@@ -94,13 +94,11 @@ void add_converge_command(CLI::App& app) {
         const std::filesystem::path dir = args->output;
         std::filesystem::create_directories(dir);
         const std::string tag = "m" + std::to_string(m);
-        write_mesh(dir / (tag + "_smooth_deformed.obj"),
-                   to_file_order(s.mesh.info, d.deformed_base(), mesh.F));
-        write_mesh(dir / (tag + "_deformed.obj"),
-                   to_file_order(s.mesh.info, results.back(), mesh.F));
+        const std::string ext = std::filesystem::path(s.mesh.file->name).extension().string();
+        write_result(dir / (tag + "_smooth_deformed" + ext), s.mesh, d.deformed_base());
+        write_result(dir / (tag + "_deformed" + ext), s.mesh, results.back());
         if (m == modes.front()) {
-          write_mesh(dir / "spatial_deformed.obj",
-                     to_file_order(s.mesh.info, mesh.V + spatial_displacement, mesh.F));
+          write_result(dir / ("spatial_deformed" + ext), s.mesh, mesh.V + spatial_displacement);
         }
       }
       // The smooth displacement d_m = s'_m - s_m against the spatial one.

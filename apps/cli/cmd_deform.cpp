@@ -21,6 +21,7 @@ void add_deform_command(CLI::App& app) {
     bool json = false;
     DeformArgs deform;
     ManifoldHarmonicsOptions harmonics;
+    WriteOptions write;
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("MESH", args->mesh, "mesh file (optional with a --scene that names one)");
@@ -39,6 +40,7 @@ void add_deform_command(CLI::App& app) {
       ->check(CLI::Range(1, 100000));
   cmd->add_flag("--json", args->json, "print one JSON object with timings and errors");
   add_harmonics_options(*cmd, args->harmonics);
+  add_write_options(*cmd, args->write);
   cmd->callback([args, cmd] {
     // The scene's settings override the defaults; options given on the command line win.
     const LoadedScene loaded_scene = load_scene(args->mesh, args->scene, args->deform.options);
@@ -77,7 +79,7 @@ void add_deform_command(CLI::App& app) {
     Vertices result;
     const FrameTimings frame = median_frame(deformer, scene.transforms, args->repeat, &result);
     if (!result.allFinite()) throw SolverError("the deformation produced non-finite positions");
-    write_mesh(args->output, to_file_order(loaded.info, result, loaded.mesh.F));
+    write_result(args->output, loaded, result, args->write);
     const SetupTimings& s = deformer.setup_timings();
     const ConstraintError e = deformer.constraint_error(result);
     const ArapReport& arap = deformer.arap_report();

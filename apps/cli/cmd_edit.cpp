@@ -57,7 +57,8 @@ void add_edit_command(CLI::App& app) {
     if (cmd->count("--eigensolver") > 0) args->editor.eigensolver = args->eigensolver;
     args->server.max_message_bytes = static_cast<size_t>(args->max_upload_mb * (1 << 20));
     server::EditorServer editor(args->server, args->editor);
-    LoadedMesh mesh = args->mesh.empty() ? server::demo_mesh() : load_mesh(args->mesh);
+    LoadedMesh mesh =
+        args->mesh.empty() ? server::demo_mesh() : load_mesh(args->mesh, Confinement::Confined);
     const std::string name = args->mesh.empty()
                                  ? server::kDemoName
                                  : std::filesystem::path(args->mesh).filename().string();

@@ -15,14 +15,16 @@ void add_info_command(CLI::App& app) {
     bool json = false;
   };
   auto args = std::make_shared<Args>();
-  cmd->add_option("MESH", args->path, "mesh file (.obj .off .ply .stl)")->required();
+  cmd->add_option("MESH", args->path, "mesh file (.obj .off .ply .stl .gltf .glb)")->required();
   cmd->add_flag("--json", args->json, "print one JSON object");
   cmd->callback([args] {
     const auto& [path, json] = *args;
-    const LoadedMesh loaded = read_mesh(path);
+    const LoadedMesh loaded = read_mesh(path, {.keep_file = true, .companions = {}});
     const MeshInfo i = compute_mesh_info(loaded.mesh);
+    const FileSummary contents = loaded.file->summary();
     nlohmann::ordered_json j;
     j["file"] = path;
+    j["format"] = contents.format;
     j["vertices"] = i.vertices;
     j["faces"] = i.faces;
     j["edges"] = i.edges;
@@ -64,6 +66,28 @@ void add_info_command(CLI::App& app) {
     j["file_vertices"] = loaded.info.file_vertices.rows();
     j["file_faces"] = loaded.info.file_faces;
     j["welded_corners"] = loaded.info.welded_corners;
+    j["welded_vertices"] = loaded.info.welded_vertices;
+    // What the file holds besides positions, and what a round trip keeps.
+    nlohmann::ordered_json polygons = nlohmann::ordered_json::object();
+    for (const auto& [corners, count] : contents.polygon_sizes)
+      polygons[std::to_string(corners)] = count;
+    j["polygons_by_corners"] = polygons;
+    j["texture_coordinates"] = contents.texture_coordinates;
+    j["uv_sets"] = contents.uv_sets;
+    j["normals"] = contents.normals;
+    j["vertex_colours"] = contents.vertex_colours;
+    j["materials"] = contents.materials;
+    j["groups"] = contents.groups;
+    if (loaded.file->format == MeshFormat::Gltf || loaded.file->format == MeshFormat::Glb) {
+      j["gltf"] = {{"meshes", contents.meshes},
+                   {"primitives", contents.primitives},
+                   {"skins", contents.skins},
+                   {"animations", contents.animations},
+                   {"morph_targets", contents.morph_targets},
+                   {"images", contents.images}};
+    }
+    if (!contents.properties.empty()) j["properties"] = contents.properties;
+    j["round_trip_keeps"] = contents.round_trip;
     const auto text = [](const nlohmann::ordered_json& v) {
       return v.is_string() ? v.get<std::string>() : json_text(v);
     };

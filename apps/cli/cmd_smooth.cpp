@@ -13,6 +13,7 @@ void add_smooth_command(CLI::App& app) {
   struct Args {
     std::string mesh, output, basis;
     ManifoldHarmonicsOptions options;
+    WriteOptions write;
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("MESH", args->mesh, "mesh file")->required();
@@ -22,6 +23,7 @@ void add_smooth_command(CLI::App& app) {
   cmd->add_option("--basis", args->basis,
                   "basis cache: read if it exists (and matches the mesh), written otherwise");
   add_harmonics_options(*cmd, args->options);
+  add_write_options(*cmd, args->write);
   cmd->callback([args] {
     const LoadedMesh loaded = load_mesh(args->mesh);
     const auto basis = obtain_basis(loaded.mesh, args->options, args->basis);
@@ -29,7 +31,7 @@ void add_smooth_command(CLI::App& app) {
     const auto M = mass_matrix(loaded.mesh, h.mass, h.laplacian);
     const Eigen::MatrixXd smooth =
         harmonics_inverse(h.basis, harmonics_forward(h.basis, M, loaded.mesh.V));
-    write_mesh(args->output, to_file_order(loaded.info, smooth, loaded.mesh.F));
+    write_result(args->output, loaded, smooth, args->write);
     std::cout << "wrote " << args->output << " (" << h.basis.cols() << " frequencies)\n";
   });
 }

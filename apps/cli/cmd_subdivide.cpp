@@ -27,6 +27,13 @@ void add_subdivide_command(CLI::App& app) {
     const LoadedMesh loaded = load_mesh(args->mesh);
     const TriangleMesh fine = subdivide(loaded.mesh, args->levels, args->scheme);
     write_mesh(args->output, fine);
+    const std::vector<std::string> lost = contents_beyond_triangles(*loaded.file);
+    if (!lost.empty()) {
+      std::cerr << args->output
+                << ": note: subdividing writes positions and triangles only; dropped:";
+      for (size_t i = 0; i < lost.size(); ++i) std::cerr << (i ? ", " : " ") << lost[i];
+      std::cerr << "\n";
+    }
     std::cout << "wrote " << args->output << " (" << fine.num_vertices() << " vertices, "
               << fine.num_faces() << " faces)\n";
   });

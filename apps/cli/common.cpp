@@ -128,8 +128,10 @@ DeformOptions DeformArgs::merged(const CLI::App& cmd, const DeformOptions& scene
   return o;
 }
 
-LoadedMesh load_mesh(const std::string& path) {
-  LoadedMesh loaded = read_mesh(path);
+LoadedMesh load_mesh(const std::string& path, Confinement confinement) {
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  LoadedMesh loaded =
+      read_mesh(path, {.keep_file = true, .companions = folder_resolver(folder, confinement)});
   const MeshReadInfo& info = loaded.info;
   if (info.unused_vertices > 0) {
     std::cerr << path << ": note: " << info.unused_vertices
@@ -144,6 +146,23 @@ LoadedMesh load_mesh(const std::string& path) {
               << " faces on the same three vertices as an earlier face were dropped\n";
   }
   return loaded;
+}
+
+void add_write_options(CLI::App& cmd, WriteOptions& options) {
+  static const auto kNormals =
+      by_name({NormalUpdate::Follow, NormalUpdate::Recompute, NormalUpdate::Rotate});
+  cmd.add_option("--normals", options.normals,
+                 "the file's normals: follow (carried by each face's deformation, default), "
+                 "recompute (from the new faces) or rotate (by each vertex's rotation)")
+      ->transform(CLI::CheckedTransformer(kNormals, CLI::ignore_case));
+}
+
+void write_result(const std::filesystem::path& path, const LoadedMesh& loaded, const Vertices& V,
+                  const WriteOptions& options) {
+  const Vertices positions = to_file_order(loaded.info, V, loaded.mesh.F).V;
+  for (const std::string& note : write_mesh_file(path, *loaded.file, positions, options)) {
+    std::cerr << path.string() << ": note: " << note << "\n";
+  }
 }
 
 ProgressCallback progress_bar(const std::string& label) {

@@ -30,8 +30,19 @@ struct DeformArgs {
   DeformOptions merged(const CLI::App& cmd, const DeformOptions& scene) const;
 };
 
-// Reads a mesh; what the reader dropped or merged is reported on stderr.
-LoadedMesh load_mesh(const std::string& path);
+// Reads a mesh, keeping the file to write it back (LoadedMesh::file); what the reader dropped or
+// merged is reported on stderr.
+// `confinement`: which of the files it names may be read (the editor's server reads only those
+// in its folder).
+LoadedMesh load_mesh(const std::string& path, Confinement confinement = Confinement::Relative);
+
+// --normals follow|recompute|rotate: how the file's normals follow the new shape.
+void add_write_options(CLI::App& cmd, WriteOptions& options);
+
+// Writes positions V (one row per mesh vertex) as the loaded file with them (mesh_file.h), in
+// the format of `path`'s extension; what it could not carry is said on stderr.
+void write_result(const std::filesystem::path& path, const LoadedMesh& loaded, const Vertices& V,
+                  const WriteOptions& options = {});
 
 // A progress bar on stderr when it is a terminal; nothing otherwise.
 ProgressCallback progress_bar(const std::string& label);

@@ -63,6 +63,8 @@ const char* tag_name(Tag tag) {
       return "selection_file";
     case Tag::SceneFile:
       return "scene_file";
+    case Tag::CompanionFile:
+      return "companion_file";
     default:
       return "binary";
   }
@@ -87,6 +89,24 @@ void check_self_contained(const std::string& text, const std::string& name) {
   }
 }
 
+// The companions uploaded with a mesh file: by their name, or (the browser sends no folders) by
+// the last part of it. A name that leaves the mesh file's folder is refused, as on disk.
+FileResolver uploaded_companions(std::shared_ptr<const std::map<std::string, std::string>> files) {
+  return [files](const std::string& name) -> std::optional<std::string> {
+    const std::filesystem::path path(name);
+    if (path.is_absolute() || std::find(path.begin(), path.end(), "..") != path.end()) {
+      throw InputError(name + ": refused (a name outside the mesh file's folder)");
+    }
+    for (const std::string& key : {name, path.filename().string()}) {
+      if (const auto it = files->find(key); it != files->end()) return it->second;
+    }
+    return std::nullopt;
+  };
+}
+
+// At most this many companions wait for their mesh file.
+constexpr size_t kMaxCompanions = 64;
+
 }  // namespace
 
 struct Pose {
@@ -103,7 +123,8 @@ struct EditorSession::State {
   LoadedMesh loaded;  // as read: the file's numbering, and the first pose's positions
   std::string name;
   std::vector<Pose> poses;
-  std::vector<PreparedBasis> bases;  // of each pose
+  std::optional<Appearance> appearance;  // the file's look (appearance.h)
+  std::vector<PreparedBasis> bases;      // of each pose
   int pose = 0;
   double diagonal = 1.0;
   int modes = 100;
@@ -191,10 +212,24 @@ void EditorSession::dispatch(bool binary, std::string_view message) {
   if (!binary) return text_message(message);
   const Tag tag = message_tag(message);
   request_ = tag_name(tag);
+  if (tag == Tag::CompanionFile) {
+    NamedFile file = decode_file(message);
+    if (!companions_) companions_ = std::make_shared<std::map<std::string, std::string>>();
+    if (companions_->size() >= kMaxCompanions) {
+      throw InputError(file.name + ": more than " + std::to_string(kMaxCompanions) +
+                       " files sent with one mesh");
+    }
+    (*companions_)[std::filesystem::path(file.name).filename().string()] = std::move(file.data);
+    return;
+  }
   if (tag == Tag::MeshFile) {
     NamedFile file = decode_file(message);
     const std::filesystem::path name = std::filesystem::path(file.name).filename();
-    LoadedMesh mesh = read_mesh_from_memory(file.data, mesh_format_from_path(name), name.string());
+    auto companions = std::move(companions_);
+    if (!companions) companions = std::make_shared<std::map<std::string, std::string>>();
+    LoadedMesh mesh = read_mesh_from_memory(
+        file.data, mesh_format_from_path(name), name.string(),
+        {.keep_file = true, .companions = uploaded_companions(std::move(companions))});
     return open(std::move(mesh), name.string());
   }
   if (!state_) throw InputError("no mesh is open");
@@ -283,12 +318,24 @@ void EditorSession::text_message(std::string_view message) {
     return send_(true, encode_preview(*s.preview));
   }
   if (type == "export_mesh") {
-    const std::string format = j.value("format", "obj");
+    const std::string own = std::filesystem::path(s.name).extension().string();
+    const std::string format = j.value("format", own.empty() ? "obj" : own.substr(1));
     const std::filesystem::path out =
         std::filesystem::path(s.name).stem().string() + "-deformed." + format;
     const TriangleMesh file_order = to_file_order(s.loaded.info, result(true), s.loaded.mesh.F);
-    return send_(true,
-                 encode_file({out.string(), encode_mesh(file_order, mesh_format_from_path(out))}));
+    if (!s.loaded.file) {  // a mesh made here (the demo)
+      return send_(
+          true, encode_file({out.string(), encode_mesh(file_order, mesh_format_from_path(out))}));
+    }
+    // Companions first: the browser saves each file it is sent.
+    EncodedMesh encoded = encode_mesh_file(*s.loaded.file, file_order.V, out);
+    for (size_t f = encoded.files.size(); f-- > 0;) {
+      send_(true, encode_file({encoded.files[f].name, std::move(encoded.files[f].bytes)}));
+    }
+    for (const std::string& note : encoded.notes) {
+      send_(false, dump({{"type", "note"}, {"message", out.string() + ": " + note}}));
+    }
+    return;
   }
   if (type == "export_scene") {
     if (s.pose > 0) {
@@ -598,6 +645,7 @@ void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
   s.deformer.emplace(mesh.mesh, basis.harmonics, s.options);
   s.bases.push_back(std::move(basis));
   s.poses.push_back({mesh.mesh.V, hex(mesh_hash(mesh.mesh))});
+  s.appearance = file_appearance(mesh);
   s.loaded = std::move(mesh);
   s.name = std::move(name);
   s.result = s.rest();
@@ -614,6 +662,14 @@ void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
 void EditorSession::send_mesh() {
   const State& s = *state_;
   send_(true, encode_mesh_message(s.rest_mesh(s.pose)));
+  if (!s.appearance) return;
+  send_(true, encode_appearance(*s.appearance));
+  for (size_t m = 0; m < s.appearance->textured.size(); ++m) {
+    if (!s.appearance->textured[m]) continue;
+    if (const auto image = s.loaded.file->texture(static_cast<int>(m))) {
+      send_(true, encode_texture(static_cast<uint32_t>(m), image->second, image->first));
+    }
+  }
 }
 
 void EditorSession::send_ready() {

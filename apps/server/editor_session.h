@@ -16,7 +16,9 @@
 //     {"type": "undo"}, {"type": "redo"}
 //     {"type": "apply_pose"}         the shown result becomes the rest shape (pins become fixed)
 //     {"type": "preview", "vertices": k}   a coarse mesh for drags (preview.h)
-//     {"type": "export_mesh", "format": "obj|off|ply|stl"}   answered with a file message
+//     {"type": "export_mesh", "format": "obj|off|ply|stl|gltf|glb"}   answered with a file
+//                                    message per file written (a .gltf's buffers after it); without
+//                                    "format", the opened file's own, everything in it kept
 //     {"type": "export_scene"}       the scene JSON of `specdeform deform --scene`
 //     {"type": "cancel"}             handled by the server at once: see cancel()
 //   server -> browser
@@ -32,6 +34,7 @@
 //                                               request "detail": the transfer's background
 //                                               factorisation became ready (its frame first)
 //     {"type": "empty", "request"}              no mesh is open (a failed or cancelled start)
+//     {"type": "note", "message": one line}     what an export dropped or changed
 //     {"type": "error", "message": one line, "request": the request's type, "cancelled": b}
 // Every request is answered: by its reply (ready, state, file, preview, a frame), or by an
 // error naming the request, after which nothing has changed; a rejected setting is followed by
@@ -41,6 +44,7 @@
 #include <atomic>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -138,7 +142,7 @@ class EditorSession {
   // The detailed result of the current transforms, as shown; `final`: with the transfer's
   // details (waits for its background factorisation; exports and poses).
   const Vertices& result(bool final = false);
-  void send_mesh();
+  void send_mesh();  // with the file's appearance and textures, if it has them
   void send_ready();
   void send_selection();
   void send_state();
@@ -153,6 +157,9 @@ class EditorSession {
   Send send_;
   Post post_;
   std::atomic<bool> computing_{false}, cancelled_{false};
+  // Files the next mesh file names (companion messages), by name: given to its reader, then kept
+  // with it for the textures the page asks for.
+  std::shared_ptr<std::map<std::string, std::string>> companions_;
   std::string request_;     // the type of the message being handled
   std::string last_error_;  // of the last request that failed
   std::unique_ptr<State> state_;

@@ -231,6 +231,41 @@ std::string encode_preview(const PreviewMesh& preview) {
   return w.take();
 }
 
+std::string encode_appearance(const Appearance& a) {
+  const uint32_t R = static_cast<uint32_t>(a.vertex.size());
+  const uint32_t T = static_cast<uint32_t>(a.corners.size() / 3);
+  const uint32_t M = static_cast<uint32_t>(a.textured.size());
+  Writer w;
+  w.reserve(20 + 4 * (2 * R + 3 * T + M + 2 + 5 * M) + 4 * a.uv.size() + a.rgba.size() + 4);
+  w.put(static_cast<uint32_t>(Tag::Appearance));
+  w.put(R);
+  w.put(T);
+  w.put(M);
+  w.put(static_cast<uint32_t>((a.uv.empty() ? 0 : 1) | (a.rgba.empty() ? 0 : 2)));
+  for (const uint32_t v : a.vertex) w.put(v);
+  for (const uint32_t g : a.normal_group) w.put(g);
+  for (const uint32_t c : a.corners) w.put(c);
+  for (const uint32_t s : a.material_start) w.put(s);
+  for (const float c : a.base_color) w.put(c);
+  for (const char t : a.textured) w.put(static_cast<uint32_t>(t));
+  for (const float u : a.uv) w.put(u);
+  for (const uint8_t c : a.rgba) w.put(c);
+  w.align4();
+  return w.take();
+}
+
+std::string encode_texture(uint32_t material, std::string_view mime, std::string_view image) {
+  Writer w;
+  w.reserve(16 + mime.size() + image.size());
+  w.put(static_cast<uint32_t>(Tag::Texture));
+  w.put(material);
+  w.put(static_cast<uint32_t>(mime.size()));
+  w.bytes(mime);
+  w.align4();
+  w.bytes(image);
+  return w.take();
+}
+
 std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& stats,
                                 const Vertices& positions, const Vertices& rest,
                                 const PreviewMesh* preview) {

@@ -16,6 +16,8 @@
 //   3 mesh file    u32 tag | u32 name length L | name (L bytes, padded with zeros to 4) | file
 //   4 selection    the same layout as 3, for a .sel or .dmat file (file numbering)
 //   5 scene        the same layout as 3, for a scene (.json, docs/scene.md)
+//   6 companion    the same layout as 3: a file the next mesh file names (an MTL, a texture, a
+//                  .gltf's buffer), by that name; sent before the mesh file
 // Server -> browser
 //   101 mesh       u32 tag | u32 n | u32 triangles T | f32 positions (3 n) | u32 corners (3 T)
 //   102 frame      u32 tag | u32 seq | u32 n | u32 view (bit 0: smooth base, bit 1: preview,
@@ -32,6 +34,15 @@
 //                  the browser to adopt (after a reload, an undo, a selection file or a scene)
 //   105 preview    u32 tag | u32 k | u32 triangles T | u32 mesh vertex of each preview vertex
 //                  (k) | u32 corners (3 T, preview numbering): a coarse view for drags
+//   106 appearance u32 tag | u32 render vertices R | u32 triangles T | u32 materials M |
+//                  u32 flags (bit 0: uv, bit 1: colours) | u32 mesh vertex (R) |
+//                  u32 normal group (R) | u32 corners (3 T, render numbering) |
+//                  u32 first triangle of each material, then of "none", then T (M + 2) |
+//                  f32 base colour RGBA (4 M) | u32 1 where the material has an image (M) |
+//                  f32 uv (2 R, if bit 0) | u8 RGBA (4 R, if bit 1): the file's look
+//                  (appearance.h), after the mesh message of a file that has one
+//   107 texture    u32 tag | u32 material | u32 MIME type length L | MIME type (L bytes, padded
+//                  with zeros to 4) | the image file's bytes
 // Half a step (the largest displacement / 65534) is below the display's resolution and below
 // 1e-5 of the bounding-box diagonal for displacements up to a third of it; exports are
 // written by the server in double precision.
@@ -45,6 +56,7 @@
 
 #include <Eigen/Geometry>
 
+#include "appearance.h"
 #include "specdeform/deform/selection.h"
 #include "specdeform/mesh/triangle_mesh.h"
 
@@ -56,11 +68,14 @@ enum class Tag : uint32_t {
   MeshFile = 3,
   SelectionFile = 4,
   SceneFile = 5,
+  CompanionFile = 6,
   Mesh = 101,
   FrameResult = 102,
   File = 103,
   SelectionResult = 104,
   Preview = 105,
+  Appearance = 106,
+  Texture = 107,
 };
 
 // Limits that bound what a message can make the server allocate.
@@ -127,6 +142,8 @@ std::string encode_frame(const FrameRequest& frame);
 std::string encode_file(const NamedFile& file, Tag tag = Tag::File);
 std::string encode_mesh_message(const TriangleMesh& mesh);
 std::string encode_preview(const PreviewMesh& preview);
+std::string encode_appearance(const Appearance& appearance);
+std::string encode_texture(uint32_t material, std::string_view mime, std::string_view image);
 // `positions` and `rest`: the whole mesh's; a preview view sends `preview`'s vertices.
 std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& stats,
                                 const Vertices& positions, const Vertices& rest,

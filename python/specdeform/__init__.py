@@ -4,12 +4,12 @@ Meshes are plain arrays: V float64 (n, 3), F integer (f, 3). Operators come back
 scipy.sparse matrices, bases as read-only views that share the solver's memory.
 
     import specdeform
-    V, F = specdeform.read_mesh("bar.off")
+    V, F = specdeform.read_mesh("bar.off")      # or V, F, file = read_mesh("a.glb", keep=True)
     evals, evecs = specdeform.manifold_harmonics(V, F, 100, cache="bar.sdbasis")
     d = specdeform.SpectralDeformer(V, F, basis=(evals, evecs), energy="arap")
     d.set_selection(handles=[top], fixed=bottom)
     X = d.solve([T])  # one 4 x 4 transform per handle group
-
+    file.write("out.glb", X)  # the file as it was, with X
 Errors: InputError (a ValueError) for bad input, SolverError (a RuntimeError) for a numerical
 failure, both specdeform.Error; OSError for a file that cannot be opened.
 """
@@ -19,6 +19,7 @@ from ._specdeform import (
     Error,
     Harmonics,
     InputError,
+    MeshFile,
     MeshReadInfo,
     SolverError,
     SpectralDeformer,
@@ -44,6 +45,7 @@ __all__ = [
     "Error",
     "Harmonics",
     "InputError",
+    "MeshFile",
     "MeshReadInfo",
     "Scene",
     "SolverError",

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstdio>
 
+#include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
 #include "bindings.h"
@@ -10,6 +11,7 @@
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/generate.h"
 #include "specdeform/mesh/io.h"
+#include "specdeform/mesh/mesh_file.h"
 
 namespace specdeform::python {
 
@@ -51,6 +53,35 @@ py::array index_view(const std::vector<int>& indices, py::handle owner) {
               owner);
 }
 
+// A file kept whole by read_mesh(..., keep=True), with the map from its mesh to the file.
+struct KeptFile {
+  std::shared_ptr<const MeshFile> file;
+  MeshReadInfo info;
+};
+
+py::dict summary_dict(const FileSummary& s) {
+  py::dict d;
+  d["format"] = s.format;
+  py::dict sizes;
+  for (const auto& [corners, count] : s.polygon_sizes) sizes[py::int_(corners)] = count;
+  d["polygons_by_corners"] = sizes;
+  d["texture_coordinates"] = s.texture_coordinates;
+  d["uv_sets"] = s.uv_sets;
+  d["normals"] = s.normals;
+  d["vertex_colours"] = s.vertex_colours;
+  d["materials"] = s.materials;
+  d["groups"] = s.groups;
+  d["meshes"] = s.meshes;
+  d["primitives"] = s.primitives;
+  d["skins"] = s.skins;
+  d["animations"] = s.animations;
+  d["morph_targets"] = s.morph_targets;
+  d["images"] = s.images;
+  d["properties"] = s.properties;
+  d["round_trip_keeps"] = s.round_trip;
+  return d;
+}
+
 }  // namespace
 
 void bind_mesh(py::module_& m) {
@@ -81,8 +112,16 @@ void bind_mesh(py::module_& m) {
                     "Triangles that repeat a vertex (dropped).")
       .def_readonly("duplicate_faces", &MeshReadInfo::duplicate_faces,
                     "Triangles on the same three vertices as an earlier one (dropped).")
+      .def_property_readonly(
+          "file_to_vertex",
+          [](py::object self) {
+            return index_view(self.cast<const MeshReadInfo&>().file_to_vertex, self);
+          },
+          "File vertex v became mesh vertex file_to_vertex[v] (-1: dropped).")
       .def_readonly("welded_corners", &MeshReadInfo::welded_corners,
                     "STL: triangle corners merged into an existing vertex.")
+      .def_readonly("welded_vertices", &MeshReadInfo::welded_vertices,
+                    "glTF: vertices split along seams merged into another.")
       .def("__repr__", [](const MeshReadInfo& i) {
         return "MeshReadInfo(file_vertices=" + std::to_string(i.file_vertices.rows()) +
                ", file_faces=" + std::to_string(i.file_faces) +
@@ -92,25 +131,93 @@ void bind_mesh(py::module_& m) {
                ", welded_corners=" + std::to_string(i.welded_corners) + ")";
       });
 
+  py::class_<KeptFile>(m, "MeshFile",
+                       "A mesh file kept whole (read_mesh(..., keep=True)), to be written again "
+                       "with new positions.")
+      .def(
+          "write",
+          [](const KeptFile& self, const std::filesystem::path& path, py::handle V,
+             const std::string& normals) {
+            check_writable(path);
+            const Vertices X = to_vertices(V);
+            if (X.rows() != static_cast<Eigen::Index>(self.info.vertex_to_file.size())) {
+              throw InputError("write: V has " + std::to_string(X.rows()) +
+                               " rows, the mesh read from the file " +
+                               std::to_string(self.info.vertex_to_file.size()) + " vertices");
+            }
+            const WriteOptions options{normal_update_from_name(normals)};
+            py::gil_scoped_release release;
+            const Vertices positions = to_file_order(self.info, X, Faces()).V;
+            return write_mesh_file(path, *self.file, positions, options);
+          },
+          py::arg("path"), py::arg("V"), py::arg("normals") = "follow",
+          R"(Writes the file again with the mesh's vertices at V (n, 3), in the format of path's
+extension, atomically: in the file's own format everything but positions and normals (glTF:
+POSITION with its min and max, NORMAL, TANGENT) as it was; in another, what that format can hold.
+normals: "follow" (carried by each face's deformation), "recompute" or "rotate". Returns notes on
+what was dropped or copied beside the output.)")
+      .def_property_readonly(
+          "info", [](const KeptFile& self) { return self.info; },
+          "The MeshReadInfo: the map from the mesh to the file.")
+      .def_property_readonly("format",
+                             [](const KeptFile& self) { return format_name(self.file->format); })
+      .def(
+          "summary", [](const KeptFile& self) { return summary_dict(self.file->summary()); },
+          "What the file holds besides positions, and what a round trip keeps.")
+      .def_property_readonly(
+          "uv",
+          [](py::object self) {
+            return view(self.cast<const KeptFile&>().file->attributes.uv, self);
+          },
+          "Texture coordinates (k, 2) as the file has them (empty: none).")
+      .def_property_readonly(
+          "corner_uv",
+          [](py::object self) {
+            return index_view(self.cast<const KeptFile&>().file->attributes.corner_uv, self);
+          },
+          "Per polygon corner, its row of uv (-1: none).")
+      .def_property_readonly(
+          "normals",
+          [](py::object self) {
+            return view(self.cast<const KeptFile&>().file->attributes.normals, self);
+          },
+          "The file's normals (k, 3) (empty: none).")
+      .def_property_readonly(
+          "colours",
+          [](py::object self) {
+            return view(self.cast<const KeptFile&>().file->attributes.colours, self);
+          },
+          "Vertex colours (file vertices, 4), RGBA in [0, 1] (empty: none).")
+      .def("__repr__", [](const KeptFile& self) {
+        return "MeshFile('" + self.file->name + "', " + format_name(self.file->format) + ")";
+      });
+
   m.def(
       "read_mesh",
-      [](const std::filesystem::path& path, bool return_info) -> py::tuple {
+      [](const std::filesystem::path& path, bool return_info, bool keep) -> py::tuple {
         check_readable(path);
         LoadedMesh loaded;
         {
           py::gil_scoped_release release;
-          loaded = read_mesh(path);
+          loaded = read_mesh(path, {.keep_file = keep, .companions = {}});
         }
         py::tuple VF = mesh_arrays(std::move(loaded.mesh));
+        if (keep) {
+          return py::make_tuple(VF[0], VF[1],
+                                KeptFile{std::move(loaded.file), std::move(loaded.info)});
+        }
         if (!return_info) return VF;
         return py::make_tuple(VF[0], VF[1], std::move(loaded.info));
       },
-      py::arg("path"), py::arg("return_info") = false,
-      R"(Reads an OBJ, OFF, PLY or STL file: (V, F), V float64 (n, 3), F int32 (f, 3).
+      py::arg("path"), py::arg("return_info") = false, py::arg("keep") = false,
+      R"(Reads an OBJ, OFF, PLY, STL or glTF (.gltf, .glb) file: (V, F), V float64 (n, 3), F int32
+(f, 3).
 
-Polygons are fan-triangulated; vertices no face uses and faces that repeat a vertex are dropped.
-With return_info=True, (V, F, info): info (a MeshReadInfo) maps the mesh back to the file.
-Raises OSError if the file cannot be opened, InputError if it is malformed.)");
+Polygons are fan-triangulated; vertices no face uses and faces that repeat a vertex are dropped;
+glTF's vertices split along seams are welded. With return_info=True, (V, F, info): info (a
+MeshReadInfo) maps the mesh back to the file. With keep=True, (V, F, file): file (a MeshFile) holds
+the whole file, and file.write(path, X) writes it again with the vertices at X (file.info is the
+map). Raises OSError if the file cannot be opened, InputError if it is malformed.)");
 
   m.def(
       "write_mesh",
@@ -129,7 +236,7 @@ Raises OSError if the file cannot be opened, InputError if it is malformed.)");
         write_mesh(path, mesh);
       },
       py::arg("path"), py::arg("V"), py::arg("F"), py::arg("info") = py::none(),
-      R"(Writes a mesh; the format from the extension (.obj .off .ply .stl), atomically.
+      R"(Writes a mesh; the format from the extension (.obj .off .ply .stl .gltf .glb), atomically.
 
 With info (from read_mesh(..., return_info=True)), in the file's numbering: the vertices the
 reader dropped are written back where they were.)");

@@ -175,7 +175,8 @@ class SceneReader {
         kept_(mesh.vertex_to_file),
         is_kept_(mesh.file_vertices.rows(), 0),
         read_file_(read_file) {
-    for (const int v : kept_) is_kept_[v] = 1;
+    for (size_t v = 0; v < mesh.file_to_vertex.size(); ++v)
+      is_kept_[v] = mesh.file_to_vertex[v] >= 0;
     if (kept_.empty()) return;
     Eigen::Vector3d lo = V_.row(kept_[0]), hi = lo;
     for (const int v : kept_) {
@@ -396,6 +397,7 @@ Scene read_scene(const std::filesystem::path& path, const Vertices& file_vertice
   all.file_vertices = file_vertices;
   all.vertex_to_file.resize(file_vertices.rows());
   std::iota(all.vertex_to_file.begin(), all.vertex_to_file.end(), 0);
+  all.file_to_vertex = all.vertex_to_file;
   return read_scene(path, all, options);
 }
 

@@ -106,26 +106,34 @@ Selection scene_selection(const Scene& scene, const LoadedMesh& mesh,
 
 Selection to_mesh_numbering(const Selection& selection, const MeshReadInfo& info,
                             std::vector<std::string>* notes, std::string_view name) {
-  std::vector<int> index(info.file_vertices.rows(), -1);
-  for (size_t i = 0; i < info.vertex_to_file.size(); ++i) index[info.vertex_to_file[i]] = int(i);
+  const std::vector<int>& index = info.file_to_vertex;
+  // Copies of one welded vertex (glTF's seams) in a list count once.
+  std::vector<char> taken(info.vertex_to_file.size(), 0);
   const auto map = [&](const std::vector<int>& in, const std::string& what) {
     std::vector<int> out;
+    size_t dropped = 0;
     for (const int v : in) {
       if (v < 0 || v >= static_cast<int>(index.size())) {
         throw InputError(std::string(name) + ": " + what + ": vertex " + std::to_string(v) +
                          " is out of range (the file has " + std::to_string(index.size()) +
                          " vertices)");
       }
-      if (index[v] >= 0) out.push_back(index[v]);
+      if (index[v] < 0) {
+        ++dropped;
+      } else if (!taken[index[v]]) {
+        taken[index[v]] = 1;
+        out.push_back(index[v]);
+      }
     }
-    if (out.size() == in.size()) return out;
+    for (const int v : out) taken[v] = 0;
+    if (dropped == 0) return out;
     if (out.empty()) {
       throw InputError(std::string(name) + ": " + what + ": all " + std::to_string(in.size()) +
                        " of its vertices (file vertex " + std::to_string(in.front()) +
                        " first) are used by no face, so the mesh reader dropped them");
     }
     if (notes != nullptr) {
-      notes->push_back(what + ": " + std::to_string(in.size() - out.size()) + " of its " +
+      notes->push_back(what + ": " + std::to_string(dropped) + " of its " +
                        std::to_string(in.size()) +
                        " vertices are used by no face and were left out");
     }

@@ -10,27 +10,17 @@
 #include <fstream>
 #include <numeric>
 #include <span>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "linalg/parallel.h"
+#include "mesh_writers.h"
 #include "polygon_soup.h"
 #include "specdeform/atomic_file.h"
 #include "specdeform/exceptions.h"
 #include "text_scanner.h"
 
 namespace specdeform {
-
-MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
-  if (ext == ".obj") return MeshFormat::Obj;
-  if (ext == ".off") return MeshFormat::Off;
-  if (ext == ".ply") return MeshFormat::Ply;
-  if (ext == ".stl") return MeshFormat::Stl;
-  throw InputError(path.string() + ": unknown mesh format '" + ext +
-                   "' (expected .obj, .off, .ply or .stl)");
-}
 
 namespace {
 
@@ -77,6 +67,18 @@ std::vector<int> fan_apexes(const detail::PolygonSoup& soup) {
 
 namespace detail {
 
+std::vector<int> weld_coincident(const std::vector<double>& xyz) {
+  const int n = static_cast<int>(xyz.size() / 3);
+  std::unordered_map<std::array<double, 3>, int, PositionHash> first;
+  first.reserve(n);
+  std::vector<int> weld(n);
+  for (int v = 0; v < n; ++v) {
+    const std::array<double, 3> p{xyz[3 * v] + 0.0, xyz[3 * v + 1] + 0.0, xyz[3 * v + 2] + 0.0};
+    weld[v] = first.try_emplace(p, v).first->second;
+  }
+  return weld;
+}
+
 LoadedMesh build_mesh(PolygonSoup soup, const std::string& name) {
   const int nv = soup.num_vertices();
   if (nv == 0) throw InputError(name + ": no vertices");
@@ -95,6 +97,9 @@ LoadedMesh build_mesh(PolygonSoup soup, const std::string& name) {
   info.file_vertices = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
       soup.xyz.data(), nv, 3);
 
+  if (!soup.weld.empty()) {
+    for (int& v : soup.indices) v = soup.weld[v];
+  }
   std::vector<int> tris;
   const std::vector<int> apex = fan_apexes(soup);
   for (int p = 0; p < soup.num_polygons(); ++p) {
@@ -160,7 +165,16 @@ LoadedMesh build_mesh(PolygonSoup soup, const std::string& name) {
       info.vertex_to_file.push_back(i);
     }
   }
-  info.unused_vertices = nv - static_cast<int>(info.vertex_to_file.size());
+  info.file_to_vertex.resize(nv);
+  for (int i = 0; i < nv; ++i) {
+    const int r = soup.weld.empty() ? i : soup.weld[i];
+    info.file_to_vertex[i] = new_index[r];
+    if (new_index[r] < 0) {
+      ++info.unused_vertices;
+    } else if (r != i) {
+      ++info.welded_vertices;
+    }
+  }
   const int n = static_cast<int>(info.vertex_to_file.size());
   out.mesh.V.resize(n, 3);
   for (int i = 0; i < n; ++i) out.mesh.V.row(i) = info.file_vertices.row(info.vertex_to_file[i]);
@@ -173,23 +187,51 @@ LoadedMesh build_mesh(PolygonSoup soup, const std::string& name) {
 
 }  // namespace detail
 
-LoadedMesh read_mesh_from_memory(std::string_view data, MeshFormat format, std::string_view name) {
+LoadedMesh read_mesh_from_memory(std::string_view data, MeshFormat format, std::string_view name,
+                                 const ReadOptions& options) {
   const std::string n(name);
   detail::reject_git_lfs_pointer(data, n, "mesh");
+  detail::KeptRecord record;
+  detail::KeptRecord* keep = options.keep_file ? &record : nullptr;
+  detail::PolygonSoup soup;
   switch (format) {
     case MeshFormat::Obj:
-      return detail::build_mesh(detail::parse_obj(data, n), n);
+      soup = detail::parse_obj(data, n, keep);
+      break;
     case MeshFormat::Off:
-      return detail::build_mesh(detail::parse_off(data, n), n);
+      soup = detail::parse_off(data, n, keep);
+      break;
     case MeshFormat::Ply:
-      return detail::build_mesh(detail::parse_ply(data, n), n);
+      soup = detail::parse_ply(data, n, keep);
+      break;
     case MeshFormat::Stl:
-      return detail::build_mesh(detail::parse_stl(data, n), n);
+      soup = detail::parse_stl(data, n, keep);
+      break;
+    case MeshFormat::Gltf:
+    case MeshFormat::Glb:
+      soup = detail::parse_gltf(data, format, n, options.companions, keep);
+      break;
   }
-  throw InputError(n + ": unknown format");
+  if (keep) {
+    record.attributes.corners = soup.indices;
+    record.attributes.offsets = soup.offsets;
+  }
+  LoadedMesh out = detail::build_mesh(std::move(soup), n);
+  if (keep) {
+    auto file = std::make_shared<MeshFile>();
+    file->format = format;
+    file->name = n;
+    file->rest = out.info.file_vertices;
+    file->attributes = std::move(record.attributes);
+    file->companions = options.companions;
+    file->layout = std::make_shared<const detail::FileLayout>(std::move(record.layout));
+    if (format == MeshFormat::Obj) detail::read_obj_materials(*file);
+    out.file = std::move(file);
+  }
+  return out;
 }
 
-LoadedMesh read_mesh(const std::filesystem::path& path) {
+LoadedMesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
   const MeshFormat format = mesh_format_from_path(path);
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError(path.string() + ": is a directory");
@@ -201,7 +243,9 @@ LoadedMesh read_mesh(const std::filesystem::path& path) {
   while (file.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || file.gcount() > 0)
     bytes.append(chunk.data(), static_cast<size_t>(file.gcount()));
   if (file.bad()) throw InputError(path.string() + ": read error");
-  return read_mesh_from_memory(bytes, format, path.string());
+  ReadOptions o = options;
+  if (!o.companions) o.companions = folder_resolver(path.parent_path());
+  return read_mesh_from_memory(bytes, format, path.string(), o);
 }
 
 MeshReadInfo identity_read_info(const TriangleMesh& mesh) {
@@ -212,165 +256,27 @@ MeshReadInfo identity_read_info(const TriangleMesh& mesh) {
   std::iota(info.vertex_to_file.begin(), info.vertex_to_file.end(), 0);
   info.face_to_file.resize(mesh.num_faces());
   std::iota(info.face_to_file.begin(), info.face_to_file.end(), 0);
+  info.file_to_vertex = info.vertex_to_file;
   return info;
 }
 
 TriangleMesh to_file_order(const MeshReadInfo& info, const Vertices& V, const Faces& F) {
   TriangleMesh out{info.file_vertices, Faces(F.rows(), 3)};
-  for (int i = 0; i < V.rows(); ++i) out.V.row(info.vertex_to_file[i]) = V.row(i);
+  for (int v = 0; v < out.V.rows(); ++v)
+    if (info.file_to_vertex[v] >= 0) out.V.row(v) = V.row(info.file_to_vertex[v]);
   for (int f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) out.F(f, k) = info.vertex_to_file[F(f, k)];
   return out;
 }
 
-namespace {
-
-void append_number(std::string& s, double v) {
-  char buf[32];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
-  s.append(buf, end);
-}
-
-void append_number(std::string& s, int v) {
-  char buf[16];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  s.append(buf, end);
-}
-
-template <typename T>
-void append_le(std::string& s, T v) {
-  static_assert(std::endian::native == std::endian::little, "writers assume a little-endian host");
-  char b[sizeof(T)];
-  std::memcpy(b, &v, sizeof(T));
-  s.append(b, sizeof(T));
-}
-
-// A text format's vertex and face lines, each list encoded in two halves at once (the first
-// halves on one thread, the second on the other): the parts of the file after its header, in
-// order (692k vertices, OBJ: 0.41 -> 0.2-0.26 s with the write).
-template <typename VertexLine, typename FaceLine>
-std::vector<std::string> text_lines(const TriangleMesh& m, const VertexLine& vertex_line,
-                                    const FaceLine& face_line) {
-  std::vector<std::string> part(4);  // vertices, first and second half; then faces
-  // Reserved for the usual line (three shortest round-trip doubles; three indices of n's
-  // digits): a string that regrows holds two copies for a moment.
-  const size_t vertex_bytes = 64, face_bytes = 3 * std::to_string(m.num_vertices()).size() + 6;
-  const auto encode = [&](int half) {
-    const auto lines = [&](int count, size_t bytes, std::string& s, const auto& line) {
-      const int begin = half * (count / 2), end = half == 0 ? count / 2 : count;
-      s.reserve(static_cast<size_t>(end - begin) * bytes);
-      for (int i = begin; i < end; ++i) line(s, i);
-    };
-    lines(m.num_vertices(), vertex_bytes, part[half], vertex_line);
-    lines(m.num_faces(), face_bytes, part[2 + half], face_line);
-  };
-  detail::run_pair([&] { encode(0); }, [&] { encode(1); });
-  return part;
-}
-
-std::vector<std::string> encode_obj(const TriangleMesh& m) {
-  std::vector<std::string> parts = text_lines(
-      m,
-      [&](std::string& s, int i) {
-        s += 'v';
-        for (int k = 0; k < 3; ++k) {
-          s += ' ';
-          append_number(s, m.V(i, k));
-        }
-        s += '\n';
-      },
-      [&](std::string& s, int f) {
-        s += 'f';
-        for (int k = 0; k < 3; ++k) {
-          s += ' ';
-          append_number(s, m.F(f, k) + 1);
-        }
-        s += '\n';
-      });
-  parts.insert(parts.begin(), "# written by specdeform\n");
-  return parts;
-}
-
-std::vector<std::string> encode_off(const TriangleMesh& m) {
-  std::vector<std::string> parts = text_lines(
-      m,
-      [&](std::string& s, int i) {
-        for (int k = 0; k < 3; ++k) {
-          append_number(s, m.V(i, k));
-          s += k < 2 ? ' ' : '\n';
-        }
-      },
-      [&](std::string& s, int f) {
-        s += '3';
-        for (int k = 0; k < 3; ++k) {
-          s += ' ';
-          append_number(s, m.F(f, k));
-        }
-        s += '\n';
-      });
-  std::string header = "OFF\n";
-  append_number(header, m.num_vertices());
-  header += ' ';
-  append_number(header, m.num_faces());
-  header += " 0\n";
-  parts.insert(parts.begin(), std::move(header));
-  return parts;
-}
-
-std::string encode_ply(const TriangleMesh& m) {
-  std::string s = "ply\nformat binary_little_endian 1.0\ncomment written by specdeform\n";
-  s += "element vertex " + std::to_string(m.num_vertices()) + "\n";
-  s += "property double x\nproperty double y\nproperty double z\n";
-  s += "element face " + std::to_string(m.num_faces()) + "\n";
-  s += "property list uchar int vertex_indices\nend_header\n";
-  for (int i = 0; i < m.num_vertices(); ++i)
-    for (int k = 0; k < 3; ++k) append_le(s, m.V(i, k));
-  for (int f = 0; f < m.num_faces(); ++f) {
-    append_le(s, uint8_t{3});
-    for (int k = 0; k < 3; ++k) append_le(s, int32_t{m.F(f, k)});
-  }
-  return s;
-}
-
-std::string encode_stl(const TriangleMesh& m) {
-  std::string s(80, ' ');
-  s.replace(0, 22, "binary STL, specdeform");
-  append_le(s, static_cast<uint32_t>(m.num_faces()));
-  const auto N = face_normals(m);
-  for (int f = 0; f < m.num_faces(); ++f) {
-    for (int k = 0; k < 3; ++k) append_le(s, static_cast<float>(N(f, k)));
-    for (int c = 0; c < 3; ++c)
-      for (int k = 0; k < 3; ++k) append_le(s, static_cast<float>(m.V(m.F(f, c), k)));
-    append_le(s, uint16_t{0});
-  }
-  return s;
-}
-
-// The file's bytes, in parts to be concatenated.
-std::vector<std::string> encode_parts(const TriangleMesh& mesh, MeshFormat format) {
-  switch (format) {
-    case MeshFormat::Obj:
-      return encode_obj(mesh);
-    case MeshFormat::Off:
-      return encode_off(mesh);
-    case MeshFormat::Ply:
-      return {encode_ply(mesh)};
-    case MeshFormat::Stl:
-      return {encode_stl(mesh)};
-  }
-  return {};
-}
-
-}  // namespace
-
 std::string encode_mesh(const TriangleMesh& mesh, MeshFormat format) {
   std::string out;
-  for (const std::string& part : encode_parts(mesh, format)) out += part;
+  for (const std::string& part : detail::encode_plain(mesh, format)) out += part;
   return out;
 }
 
 void write_mesh(const std::filesystem::path& path, const TriangleMesh& mesh) {
-  const std::vector<std::string> parts = encode_parts(mesh, mesh_format_from_path(path));
+  const std::vector<std::string> parts = detail::encode_plain(mesh, mesh_format_from_path(path));
   const std::vector<std::string_view> views(parts.begin(), parts.end());
   write_file_atomically(path, views);
 }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <numeric>
 #include <string>
 #include <vector>
 
@@ -11,22 +12,35 @@
 
 namespace specdeform::detail {
 
+size_t ply_scalar_size(PlyScalar s) {
+  switch (s) {
+    case PlyScalar::I8:
+    case PlyScalar::U8:
+      return 1;
+    case PlyScalar::I16:
+    case PlyScalar::U16:
+      return 2;
+    case PlyScalar::I32:
+    case PlyScalar::U32:
+    case PlyScalar::F32:
+      return 4;
+    case PlyScalar::F64:
+      return 8;
+  }
+  return 0;
+}
+
+const char* ply_scalar_name(PlyScalar s) {
+  static constexpr const char* kNames[] = {"char", "uchar", "short", "ushort",
+                                           "int",  "uint",  "float", "double"};
+  return kNames[static_cast<int>(s)];
+}
+
 namespace {
 
-enum class Scalar { I8, U8, I16, U16, I32, U32, F32, F64 };
-
-struct Property {
-  std::string name;
-  Scalar type = Scalar::F32;
-  bool is_list = false;
-  Scalar count_type = Scalar::U8;
-};
-
-struct Element {
-  std::string name;
-  long long count = 0;
-  std::vector<Property> properties;
-};
+using Scalar = PlyScalar;
+using Property = PlyProperty;
+using Element = PlyElement;
 
 bool parse_scalar(std::string_view t, Scalar& out) {
   static constexpr std::pair<std::string_view, Scalar> kNames[] = {
@@ -45,35 +59,17 @@ bool parse_scalar(std::string_view t, Scalar& out) {
   return false;
 }
 
-size_t scalar_size(Scalar s) {
-  switch (s) {
-    case Scalar::I8:
-    case Scalar::U8:
-      return 1;
-    case Scalar::I16:
-    case Scalar::U16:
-      return 2;
-    case Scalar::I32:
-    case Scalar::U32:
-    case Scalar::F32:
-      return 4;
-    case Scalar::F64:
-      return 8;
-  }
-  return 0;
-}
-
 // Reads the body's values one at a time, whatever the encoding.
 class BodyReader {
  public:
-  enum class Encoding { Ascii, Little, Big };
+  using Encoding = PlyEncoding;
 
   BodyReader(std::string_view body, Encoding enc, const std::string& name)
       : body_(body), enc_(enc), text_(body, name), name_(name) {}
 
   double read(Scalar s, const char* what) {
     if (enc_ == Encoding::Ascii) return text_.next_double(what);
-    const size_t size = scalar_size(s);
+    const size_t size = ply_scalar_size(s);
     if (pos_ + size > body_.size()) {
       throw InputError(name_ + ": truncated binary data while reading " + what);
     }
@@ -110,9 +106,8 @@ class BodyReader {
   }
 
   // Bytes (binary) or characters (ascii) left after the current position.
-  size_t remaining() const {
-    return enc_ == Encoding::Ascii ? body_.size() - text_.position() : body_.size() - pos_;
-  }
+  size_t remaining() const { return body_.size() - position(); }
+  size_t position() const { return enc_ == Encoding::Ascii ? text_.position() : pos_; }
 
  private:
   template <typename T>
@@ -165,7 +160,7 @@ int index_list(const Element& e, const std::string& name) {
 
 }  // namespace
 
-PolygonSoup parse_ply(std::string_view data, const std::string& name) {
+PolygonSoup parse_ply(std::string_view data, const std::string& name, KeptRecord* keep) {
   if (data.empty()) throw InputError(name + ": empty file");
   const size_t header_end = data.find("end_header");
   if (!data.starts_with("ply")) throw InputError(name + ": not a PLY file (no 'ply' magic)");
@@ -231,18 +226,61 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name) {
   if (face == nullptr && strips == nullptr) {
     throw InputError(name + ": no faces (a point cloud is not a surface)");
   }
-  int xyz_index[3] = {-1, -1, -1};
+  // What each vertex property is to the mesh; -1: nothing it uses.
+  enum Role { X, Y, Z, NX, NY, NZ, RED, GREEN, BLUE, ALPHA, U, V, kRoles };
+  static constexpr std::pair<std::string_view, Role> kRoleNames[] = {
+      {"x", X},         {"y", Y},         {"z", Z},         {"nx", NX},     {"ny", NY},
+      {"nz", NZ},       {"red", RED},     {"green", GREEN}, {"blue", BLUE}, {"alpha", ALPHA},
+      {"s", U},         {"t", V},         {"u", U},         {"v", V},       {"texture_u", U},
+      {"texture_v", V}, {"texture_s", U}, {"texture_t", V}};
+  std::vector<int> role(vertex->properties.size(), -1);
+  int where[kRoles];
+  std::fill(std::begin(where), std::end(where), -1);
   for (size_t i = 0; i < vertex->properties.size(); ++i) {
     const Property& p = vertex->properties[i];
-    for (int k = 0; k < 3; ++k) {
-      if (!p.is_list && p.name == std::string(1, static_cast<char>('x' + k))) xyz_index[k] = int(i);
+    for (const auto& [n, r] : kRoleNames) {
+      if (!p.is_list && p.name == n && where[r] < 0) {
+        role[i] = r;
+        where[r] = static_cast<int>(i);
+      }
     }
   }
-  if (xyz_index[0] < 0 || xyz_index[1] < 0 || xyz_index[2] < 0) {
+  if (where[X] < 0 || where[Y] < 0 || where[Z] < 0) {
     throw InputError(name + ": PLY vertices lack an x, y or z property");
   }
   const int face_list = face != nullptr ? index_list(*face, name) : -1;
   const int strip_list = strips != nullptr ? index_list(*strips, name) : -1;
+  int face_texcoord = -1;
+  for (size_t i = 0; face != nullptr && i < face->properties.size(); ++i) {
+    if (face->properties[i].is_list && face->properties[i].name == "texcoord")
+      face_texcoord = int(i);
+  }
+
+  PlyLayout layout;
+  const bool normals = where[NX] >= 0 && where[NY] >= 0 && where[NZ] >= 0;
+  const bool colours = where[RED] >= 0 && where[GREEN] >= 0 && where[BLUE] >= 0;
+  const bool vertex_uv = where[U] >= 0 && where[V] >= 0;
+  std::vector<double> values(kRoles);  // of the vertex being read
+  std::vector<double> face_uv;         // the faces' texcoord lists, u v per corner
+  FileAttributes* a = keep ? &keep->attributes : nullptr;
+  if (keep) {
+    layout.encoding = enc;
+    layout.vertex_element = static_cast<int>(vertex - elements.data());
+    for (int k = 0; k < 3; ++k) {
+      layout.xyz[k] = where[X + k];
+      layout.normal[k] = normals ? where[NX + k] : -1;
+    }
+    layout.vertex.reserve(vertex->count);
+    if (normals) a->normals.setZero(vertex->count, 3);
+    if (colours) a->colours.setOnes(vertex->count, 4);
+    if (vertex_uv) a->uv.setZero(vertex->count, 2);
+  }
+  // A colour channel in [0, 1] from its type's range.
+  const auto channel = [&](int r) {
+    const Scalar t = vertex->properties[where[r]].type;
+    const double scale = t == Scalar::U8 ? 255.0 : t == Scalar::U16 ? 65535.0 : 1.0;
+    return static_cast<float>(values[r] / scale);
+  };
 
   BodyReader in(data.substr(body_start), enc, name);
   PolygonSoup soup;
@@ -254,15 +292,12 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name) {
                        std::to_string(e.count) + " entries)");
     }
     for (long long r = 0; r < e.count; ++r) {
-      double xyz[3] = {0, 0, 0};
+      if (keep && &e == vertex) layout.vertex.push_back(body_start + in.position());
       for (size_t i = 0; i < e.properties.size(); ++i) {
         const Property& p = e.properties[i];
         if (!p.is_list) {
           const double v = in.read(p.type, e.name.c_str());
-          if (&e == vertex) {
-            for (int k = 0; k < 3; ++k)
-              if (xyz_index[k] == int(i)) xyz[k] = v;
-          }
+          if (&e == vertex && role[i] >= 0) values[role[i]] = v;
           continue;
         }
         const double count = in.read(p.count_type, "a list length");
@@ -271,8 +306,10 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name) {
         }
         const bool is_face = &e == face && int(i) == face_list;
         const bool is_strip = &e == strips && int(i) == strip_list;
+        const bool is_texcoord = keep && &e == face && int(i) == face_texcoord;
         for (long long c = 0; c < static_cast<long long>(count); ++c) {
           const double v = in.read(p.type, "a list");
+          if (is_texcoord) face_uv.push_back(v);
           if (!is_face && !is_strip) continue;
           if (!(v >= (is_strip ? -1 : 0) && v < static_cast<double>(vertex->count)) ||
               v != std::floor(v)) {
@@ -291,9 +328,39 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name) {
         if (is_face) soup.end_polygon();
         if (is_strip) strip.restart();
       }
-      if (&e == vertex) soup.xyz.insert(soup.xyz.end(), xyz, xyz + 3);
+      if (&e == vertex) {
+        soup.xyz.insert(soup.xyz.end(), {values[X], values[Y], values[Z]});
+        if (keep && normals) a->normals.row(r) << values[NX], values[NY], values[NZ];
+        if (keep && colours) {
+          a->colours.row(r) << channel(RED), channel(GREEN), channel(BLUE),
+              where[ALPHA] >= 0 ? channel(ALPHA) : 1.0f;
+        }
+        if (keep && vertex_uv) a->uv.row(r) << values[U], values[V];
+      }
       in.end_entry();
     }
+  }
+  // Exporters split a vertex where its texture coordinates or normals differ (Blender's along UV
+  // seams): such files are welded where positions coincide, as glTF's are, or the seams open.
+  if (vertex_uv || normals) soup.weld = weld_coincident(soup.xyz);
+  if (keep) {
+    // Per-vertex normals and uvs: each corner uses its vertex's row; the faces' texcoord lists,
+    // when they have them, give each corner a row of its own.
+    if (normals) a->corner_normal = soup.indices;
+    if (face_texcoord >= 0 && face_uv.size() != 2 * soup.indices.size()) {
+      throw InputError(name + ": the faces' texcoord lists do not hold two numbers per corner");
+    }
+    if (face_texcoord >= 0) {
+      a->uv = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(
+          face_uv.data(), Eigen::Index(face_uv.size() / 2), 2);
+      a->corner_uv.resize(soup.indices.size());
+      std::iota(a->corner_uv.begin(), a->corner_uv.end(), 0);
+    } else if (vertex_uv) {
+      a->corner_uv = soup.indices;
+    }
+    layout.elements = std::move(elements);
+    keep->layout.bytes.assign(data);
+    keep->layout.format = std::move(layout);
   }
   return soup;
 }

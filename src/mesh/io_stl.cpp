@@ -11,18 +11,6 @@ namespace specdeform::detail {
 
 namespace {
 
-struct PointHash {
-  size_t operator()(const std::array<double, 3>& p) const {
-    size_t h = 0;
-    for (const double v : p) {
-      uint64_t bits;
-      std::memcpy(&bits, &v, sizeof bits);
-      h ^= std::hash<uint64_t>{}(bits) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
-    }
-    return h;
-  }
-};
-
 // Merges exactly coincident corners into one vertex.
 class Welder {
  public:
@@ -41,10 +29,10 @@ class Welder {
 
  private:
   PolygonSoup& soup_;
-  std::unordered_map<std::array<double, 3>, int, PointHash> index_;
+  std::unordered_map<std::array<double, 3>, int, PositionHash> index_;
 };
 
-PolygonSoup parse_binary(std::string_view data, const std::string& name) {
+PolygonSoup parse_binary(std::string_view data, const std::string& name, KeptRecord* keep) {
   uint32_t count = 0;
   std::memcpy(&count, data.data() + 80, 4);
   const uint64_t expected = 84 + 50 * uint64_t{count};
@@ -56,30 +44,45 @@ PolygonSoup parse_binary(std::string_view data, const std::string& name) {
   if (count == 0) throw InputError(name + ": no faces (binary STL with 0 triangles)");
   PolygonSoup soup;
   Welder welder(soup);
+  if (keep) keep->attributes.normals.resize(count, 3);
   for (uint32_t t = 0; t < count; ++t) {
-    const char* rec = data.data() + 84 + 50 * size_t{t} + 12;  // skip the normal
-    for (int c = 0; c < 3; ++c) {
-      float p[3];
-      std::memcpy(p, rec + 12 * c, 12);
-      welder.add_corner(p[0], p[1], p[2]);
-    }
+    const char* rec = data.data() + 84 + 50 * size_t{t};
+    float p[12];  // the normal, then the corners
+    std::memcpy(p, rec, sizeof p);
+    for (int c = 1; c <= 3; ++c) welder.add_corner(p[3 * c], p[3 * c + 1], p[3 * c + 2]);
     soup.end_polygon();
+    if (keep) keep->attributes.normals.row(t) << p[0], p[1], p[2];
   }
+  if (keep) keep->layout.format = StlLayout{};
   return soup;
 }
 
-PolygonSoup parse_ascii(std::string_view data, const std::string& name) {
+PolygonSoup parse_ascii(std::string_view data, const std::string& name, KeptRecord* keep) {
   TextScanner in(data, name);
   PolygonSoup soup;
   Welder welder(soup);
   bool in_loop = false;
+  StlLayout layout;
+  layout.ascii = true;
+  std::vector<double> normals;  // 3 per facet
+  // The offset of the next token, which the scanner is about to read.
+  const auto next_offset = [&] {
+    const size_t at = in.position();
+    const std::string_view t = in.next(false);
+    in.set_position(at);
+    return size_t(t.data() - data.data());
+  };
   for (std::string_view t = in.next(false); !t.empty(); t = in.next(false)) {
     if (t == "solid" || t == "endsolid") {
       in.skip_line();  // the solid's name
+    } else if (keep && t == "normal") {
+      layout.facet_normal.push_back(next_offset());
+      for (int k = 0; k < 3; ++k) normals.push_back(in.next_double("a facet normal"));
     } else if (t == "outer") {
       in_loop = true;
     } else if (t == "vertex") {
       if (!in_loop) in.fail("'vertex' outside an 'outer loop'");
+      if (keep) layout.corner.push_back(next_offset());
       const double x = in.next_double("a vertex");
       const double y = in.next_double("a vertex");
       const double z = in.next_double("a vertex");
@@ -92,12 +95,19 @@ PolygonSoup parse_ascii(std::string_view data, const std::string& name) {
   }
   if (in_loop) in.fail("truncated ASCII STL (unterminated loop)");
   if (soup.num_polygons() == 0) in.fail("no faces");
+  if (keep) {
+    if (layout.facet_normal.size() != size_t(soup.num_polygons())) {
+      in.fail("a facet without a normal");
+    }
+    keep->attributes.normals =
+        Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
+            normals.data(), soup.num_polygons(), 3);
+    keep->layout.format = std::move(layout);
+  }
   return soup;
 }
 
-}  // namespace
-
-PolygonSoup parse_stl(std::string_view data, const std::string& name) {
+PolygonSoup parse_stl_soup(std::string_view data, const std::string& name, KeptRecord* keep) {
   if (data.empty()) throw InputError(name + ": empty file");
   const size_t first = data.find_first_not_of(" \t\r\n");
   const bool says_solid =
@@ -107,10 +117,23 @@ PolygonSoup parse_stl(std::string_view data, const std::string& name) {
     std::memcpy(&count, data.data() + 80, 4);
     const bool sized_as_binary = data.size() == 84 + 50 * uint64_t{count};
     // Many binary files begin their free-form header with "solid"; the size decides.
-    if (sized_as_binary || !says_solid) return parse_binary(data, name);
+    if (sized_as_binary || !says_solid) return parse_binary(data, name, keep);
   }
   if (!says_solid) throw InputError(name + ": too short for a binary STL and not ASCII STL");
-  return parse_ascii(data, name);
+  return parse_ascii(data, name, keep);
+}
+
+}  // namespace
+
+PolygonSoup parse_stl(std::string_view data, const std::string& name, KeptRecord* keep) {
+  PolygonSoup soup = parse_stl_soup(data, name, keep);
+  if (keep) {
+    // The facet normals, one row a facet.
+    std::vector<int>& normal = keep->attributes.corner_normal;
+    for (int p = 0; p < soup.num_polygons(); ++p) normal.resize(soup.offsets[p + 1], p);
+    keep->layout.bytes.assign(data);
+  }
+  return soup;
 }
 
 }  // namespace specdeform::detail

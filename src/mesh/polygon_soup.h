@@ -1,10 +1,15 @@
 // Internal: what every format reader produces before validation and clean-up.
 #pragma once
 
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "file_layout.h"
 #include "specdeform/mesh/io.h"
 
 namespace specdeform::detail {
@@ -13,6 +18,7 @@ struct PolygonSoup {
   std::vector<double> xyz;      // 3 per file vertex
   std::vector<int> indices;     // polygon corners, concatenated
   std::vector<int> offsets{0};  // polygon p has corners indices[offsets[p] .. offsets[p+1])
+  std::vector<int> weld;        // glTF: file vertex v is welded into weld[v] (empty: none)
   int welded_corners = 0;
 
   void add_polygon_corner(int v) { indices.push_back(v); }
@@ -21,11 +27,42 @@ struct PolygonSoup {
   int num_polygons() const { return static_cast<int>(offsets.size()) - 1; }
 };
 
-// Each reader throws InputError("<name>: <problem>") for malformed data.
-PolygonSoup parse_obj(std::string_view data, const std::string& name);
-PolygonSoup parse_off(std::string_view data, const std::string& name);
-PolygonSoup parse_ply(std::string_view data, const std::string& name);
-PolygonSoup parse_stl(std::string_view data, const std::string& name);
+// What a reader keeps to write the file back (ReadOptions::keep_file): the layout and the
+// attributes but the polygons, which build_mesh takes from the soup.
+struct KeptRecord {
+  FileAttributes attributes;
+  FileLayout layout;
+};
+
+// Each reader throws InputError("<name>: <problem>") for malformed data; with `keep`, it records
+// the file there as well.
+PolygonSoup parse_obj(std::string_view data, const std::string& name, KeptRecord* keep);
+PolygonSoup parse_off(std::string_view data, const std::string& name, KeptRecord* keep);
+PolygonSoup parse_ply(std::string_view data, const std::string& name, KeptRecord* keep);
+PolygonSoup parse_stl(std::string_view data, const std::string& name, KeptRecord* keep);
+PolygonSoup parse_gltf(std::string_view data, MeshFormat format, const std::string& name,
+                       const FileResolver& companions, KeptRecord* keep);
+
+// An OBJ's materials completed from the MTL files it names (Kd, map_Kd), read through its
+// companions; those it cannot read stay plain.
+void read_obj_materials(MeshFile& file);
+
+// Hashes a position's bits (callers add +0.0 first, so that -0.0 and +0.0 weld).
+struct PositionHash {
+  size_t operator()(const std::array<double, 3>& p) const {
+    size_t h = 0;
+    for (const double v : p) {
+      uint64_t bits;
+      std::memcpy(&bits, &v, sizeof bits);
+      h ^= std::hash<uint64_t>{}(bits) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+    }
+    return h;
+  }
+};
+
+// Each vertex of `xyz` (3 per vertex) welded into the first at exactly the same position (-0.0
+// as +0.0): PolygonSoup::weld for files that split vertices where their attributes differ.
+std::vector<int> weld_coincident(const std::vector<double>& xyz);
 
 // Validates the soup (indices, finiteness, emptiness), triangulates it and drops what no face
 // uses; throws InputError naming `name`.

@@ -211,6 +211,7 @@ TEST_F(SceneFiles, VerticesTheReaderDropped) {
   info.file_vertices.resize(6, 3);
   info.file_vertices << 100, -10, 0, 0, 0, 0, 1, 1, 0, 50, 2, 0, 0, 3, 0, 1, 4, 0;
   info.vertex_to_file = {1, 2, 4, 5};
+  info.file_to_vertex = {-1, 0, 1, -1, 2, 3};
   std::vector<std::string> notes;
   expect(
       [&] {
@@ -252,6 +253,7 @@ TEST_F(SceneFiles, ParsedFromMemoryWithItsFiles) {
   MeshReadInfo info;
   info.file_vertices = V;
   info.vertex_to_file = {0, 1, 2};
+  info.file_to_vertex = {0, 1, 2};
   std::vector<std::filesystem::path> asked;
   const SceneFileReader reader = [&](const std::filesystem::path& p) -> std::string {
     asked.push_back(p);

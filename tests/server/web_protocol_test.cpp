@@ -26,16 +26,14 @@ TEST(WebProtocol, TagsMatchTheServers) {
        it != std::sregex_iterator(); ++it) {
     web[(*it)[1]] = static_cast<uint32_t>(std::stoul((*it)[2]));
   }
-  const std::map<std::string, Tag> server = {{"Selection", Tag::Selection},
-                                             {"Frame", Tag::Frame},
-                                             {"MeshFile", Tag::MeshFile},
-                                             {"SelectionFile", Tag::SelectionFile},
-                                             {"SceneFile", Tag::SceneFile},
-                                             {"Mesh", Tag::Mesh},
-                                             {"FrameResult", Tag::FrameResult},
-                                             {"File", Tag::File},
-                                             {"SelectionResult", Tag::SelectionResult},
-                                             {"Preview", Tag::Preview}};
+  const std::map<std::string, Tag> server = {
+      {"Selection", Tag::Selection}, {"Frame", Tag::Frame},
+      {"MeshFile", Tag::MeshFile},   {"SelectionFile", Tag::SelectionFile},
+      {"SceneFile", Tag::SceneFile}, {"CompanionFile", Tag::CompanionFile},
+      {"Mesh", Tag::Mesh},           {"FrameResult", Tag::FrameResult},
+      {"File", Tag::File},           {"SelectionResult", Tag::SelectionResult},
+      {"Preview", Tag::Preview},     {"Appearance", Tag::Appearance},
+      {"Texture", Tag::Texture}};
   EXPECT_EQ(web.size(), server.size());
   for (const auto& [name, tag] : server) {
     ASSERT_TRUE(web.count(name)) << name << " is missing from protocol.ts";

@@ -14,7 +14,9 @@
 //    transform about the handle's centroid (the server's result follows it), Esc and a
 //    right-click cancel; the area, volume and stretch readouts; the numpad's views; select
 //    linked, invert, grow and shrink;
-//  - open another mesh, confirming that the edit is discarded.
+//  - open another mesh, confirming that the edit is discarded;
+//  - open a textured .glb (its texture drawn), export it as opened: the same file; open an OBJ
+//    with its MTL and image chosen together: textured too.
 //
 //   node e2e/editor.e2e.mjs [--mesh FILE] [--seconds S] [--out DIR] [--quick] [--min-ratio R]
 //
@@ -27,6 +29,7 @@ import { basename, dirname, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { parseArgs } from 'node:util';
 import { launchChromium, startEditor } from './harness.mjs';
+import { writeTexturedGlb, writeTexturedObj } from './textured.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const { values: args } = parseArgs({
@@ -385,6 +388,33 @@ try {
       null, { timeout: 60000 });
     const shown = await page.$$eval('#notes .note', (els) => els.map((e) => e.textContent));
     check(!shown.some((t) => /sending/.test(t)), `the "sending" note is gone once the mesh is open (${JSON.stringify(shown)})`);
+
+    await texturedFiles();
+  }
+
+  // A textured .glb: drawn with its image; exported as opened with nothing moved, the same
+  // bytes. An OBJ chosen with its MTL and image: textured as well.
+  async function texturedFiles() {
+    log('textured glTF and OBJ');
+    const glb = resolve(args.out, 'cube.glb');
+    writeTexturedGlb(glb);
+    const open = async (files, name) => {
+      await page.setInputFiles('#open-mesh', files);
+      if (await page.$('#confirm[open]')) await page.click('#confirm-yes');
+      await page.waitForFunction((n) => document.querySelector('#mesh-name').textContent.startsWith(n),
+        name, { timeout: 60000 });
+      await page.waitForFunction(() => window.specdeformEditor.look().textures > 0, null, { timeout: 10000 });
+      await waitReady(30000);
+      const look = await api(() => window.specdeformEditor.look());
+      check(look.present && look.drawn && look.textures === 1, `${name}: its look is drawn with its image (${JSON.stringify(look)})`);
+    };
+    await open(glb, 'cube.glb: 8 vertices');
+    await page.screenshot({ path: resolve(args.out, 'textured.png') });
+    await page.selectOption('#export-format', '');
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('#export-mesh')]);
+    check(download.suggestedFilename() === 'cube-deformed.glb', `exported as a .glb (${download.suggestedFilename()})`);
+    check(readFileSync(await download.path()).equals(readFileSync(glb)), 'the exported .glb, nothing moved, is the opened one');
+    await open(writeTexturedObj(args.out), 'cube.obj: 8 vertices');
   }
 
   // Typed modal transforms (exact, about the handle's centroid, the result following), cancel,

@@ -3,6 +3,7 @@
 // and stretch against the input (measures.ts), and the brush (the vertices within a radius, along the surface or in space), so that
 // the page keeps taking pointer events while a large mesh is processed.
 import { Brush } from './brush';
+import { groupNormals } from './look';
 import { Measures, MeshMeasures } from './measures';
 import { vertexNormals } from './normals';
 
@@ -10,11 +11,14 @@ export type Slot = 'full' | 'preview';
 
 export type WorkerRequest =
   | { kind: 'mesh'; slot: Slot; indices: Uint32Array; rest: Float32Array }
+  // The full mesh's file look: render vertices (their mesh vertex and normal group) and triangles.
+  | { kind: 'look'; vertex: Uint32Array; group: Uint32Array; indices: Uint32Array }
   | { kind: 'frame'; slot: Slot; seq: number; scale: number; displacements: Int16Array }
   | { kind: 'brush'; id: number; vertex: number; center: [number, number, number]; radius: number; geodesic: boolean };
 
 export type WorkerReply =
-  | { kind: 'frame'; slot: Slot; seq: number; positions: Float32Array; normals: Float32Array; measures: Measures | null }
+  | { kind: 'frame'; slot: Slot; seq: number; positions: Float32Array; normals: Float32Array;
+      lookNormals: Float32Array | null; measures: Measures | null }
   | { kind: 'brush'; id: number; vertices: Uint32Array };
 
 interface Mesh {
@@ -25,13 +29,26 @@ interface Mesh {
   positions: Float32Array; // the last frame's (the brush measures on them)
 }
 
+interface Look {
+  vertex: Uint32Array;
+  group: Uint32Array;
+  indices: Uint32Array;
+  sums: Float32Array; // 3 per group
+}
+
 const meshes: Partial<Record<Slot, Mesh>> = {};
+let look: Look | null = null;
 const post = (reply: WorkerReply, transfer: Transferable[]) =>
   (self as unknown as Worker).postMessage(reply, transfer);
 
 self.onmessage = (e: MessageEvent<WorkerRequest>) => {
   const m = e.data;
-  if (m.kind === 'mesh') {
+  if (m.kind === 'look') {
+    let groups = 0;
+    for (const g of m.group) groups = Math.max(groups, g + 1);
+    look = { vertex: m.vertex, group: m.group, indices: m.indices, sums: new Float32Array(3 * groups) };
+  } else if (m.kind === 'mesh') {
+    if (m.slot === 'full') look = null; // its look, if any, follows
     meshes[m.slot] = {
       indices: m.indices,
       rest: m.rest,
@@ -47,9 +64,15 @@ self.onmessage = (e: MessageEvent<WorkerRequest>) => {
     for (let i = 0; i < d.length; ++i) positions[i] = rest[i] + m.scale * d[i];
     const normals = new Float32Array(positions.length);
     vertexNormals(positions, mesh.indices, normals);
+    let lookNormals: Float32Array | null = null;
+    if (m.slot === 'full' && look) {
+      lookNormals = new Float32Array(3 * look.vertex.length);
+      groupNormals(positions, look.vertex, look.group, look.indices, look.sums, lookNormals);
+    }
     const copy = positions.slice();
     const measures = mesh.measures?.of(positions) ?? null;
-    post({ kind: 'frame', slot: m.slot, seq: m.seq, positions: copy, normals, measures }, [copy.buffer, normals.buffer]);
+    const transfer = lookNormals ? [copy.buffer, normals.buffer, lookNormals.buffer] : [copy.buffer, normals.buffer];
+    post({ kind: 'frame', slot: m.slot, seq: m.seq, positions: copy, normals, lookNormals, measures }, transfer);
   } else {
     const mesh = meshes.full;
     if (!mesh?.brush) return;

@@ -36,6 +36,7 @@ const viewer = state.viewer;
   cameraPosition: () => viewer.camera.position.toArray(),
   cameraTarget: () => viewer.orbit.target.toArray(),
   measures: () => state.measures,
+  look: () => ({ present: viewer.look.present, drawn: viewer.drawingLook, textures: viewer.look.textures }),
   cursor: () => interaction.cursor?.toArray() ?? null,
   gizmoOnScreen: () => (viewer.gizmo.object ? viewer.toScreen(viewer.pivot.position) : null),
   setView: (direction: [number, number, number], zoom = 1, at?: [number, number, number]) => {

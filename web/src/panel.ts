@@ -18,6 +18,8 @@ const HINTS: Record<Tool, string> = {
   move: 'Move: drag a coloured handle or the gizmo at the pivot, or press G, R or S (then X/Y/Z, a value, Enter); Esc cancels.',
 };
 
+const MESH_FILE = /\.(obj|off|ply|stl|gltf|glb)$/i;
+
 export class Panel {
   private shownNotes = 0; // notes already turned into toasts
   private lastPhase = '';
@@ -77,10 +79,16 @@ export class Panel {
         if (f) await this.openFile(f, tag, what, confirm);
       });
     };
-    fileInput('open-mesh', P.Tag.MeshFile, 'open mesh', 'Opening another mesh');
+    $<HTMLInputElement>('open-mesh').addEventListener('change', async (e) => {
+      const input = e.target as HTMLInputElement;
+      const files = [...(input.files ?? [])];
+      input.value = '';
+      await this.openMesh(files);
+    });
     fileInput('open-selection', P.Tag.SelectionFile, 'load selection', 'Loading a selection');
     fileInput('open-scene', P.Tag.SceneFile, 'open scene', 'Opening a scene');
     $('wireframe').addEventListener('change', (e) => s.viewer.setWireframe((e.target as HTMLInputElement).checked));
+    $('show-look').addEventListener('change', (e) => s.viewer.showLook((e.target as HTMLInputElement).checked));
     $('show-base').addEventListener('change', (e) =>
       s.request({ type: 'settings', view: (e.target as HTMLInputElement).checked ? 'base' : 'detailed' }, 'view', 'ready'));
     // Fields: Enter applies and leaves the field (so that shortcuts work again), Escape puts the
@@ -162,7 +170,11 @@ export class Panel {
     });
     $('apply-pose').addEventListener('click', () => s.request({ type: 'apply_pose' }, 'apply pose', 'state'));
     $('export-mesh').addEventListener('click', () =>
-      s.request({ type: 'export_mesh', format: $<HTMLSelectElement>('export-format').value as 'obj' }, 'export mesh', 'file'));
+      s.request({ type: 'export_mesh', ...exportFormat() }, 'export mesh', 'file'));
+    const exportFormat = () => {
+      const format = $<HTMLSelectElement>('export-format').value as P.ExportFormat | '';
+      return format === '' ? {} : { format };
+    };
     $('export-scene').addEventListener('click', () => s.request({ type: 'export_scene' }, 'export scene', 'file'));
 
     window.addEventListener('keydown', (e) => this.key(e));
@@ -175,12 +187,28 @@ export class Panel {
     window.addEventListener('drop', (e) => {
       e.preventDefault();
       document.body.classList.remove('drop');
-      const f = e.dataTransfer?.files[0];
+      const files = [...(e.dataTransfer?.files ?? [])];
+      const f = files[0];
       if (!f) return;
       if (/\.(sel|dmat)$/i.test(f.name)) this.openFile(f, P.Tag.SelectionFile, 'load selection', 'Loading a selection');
       else if (/\.json$/i.test(f.name)) this.openFile(f, P.Tag.SceneFile, 'open scene', 'Opening a scene');
-      else this.openFile(f, P.Tag.MeshFile, 'open mesh', 'Opening another mesh');
+      else this.openMesh(files);
     });
+  }
+
+  // A mesh file and the files it names (an MTL and its textures, a .gltf's buffers), chosen or
+  // dropped together: those first, as companions, then the mesh.
+  private async openMesh(files: File[]): Promise<void> {
+    const mesh = files.find((f) => MESH_FILE.test(f.name));
+    if (!mesh) {
+      if (files.length > 0) this.s.note(`no mesh among ${files.map((f) => f.name).join(', ')} (.obj .off .ply .stl .gltf .glb)`, 'error');
+      return;
+    }
+    if (!(await this.confirmDiscard('Opening another mesh'))) return;
+    for (const f of files) {
+      if (f !== mesh) this.s.connection.send(P.encodeFile(P.Tag.CompanionFile, f.name, await f.arrayBuffer()));
+    }
+    await this.openFile(mesh, P.Tag.MeshFile, 'open mesh', null);
   }
 
   private async openFile(f: File, tag: P.FileTag, what: string, confirm: string | null): Promise<void> {

@@ -9,14 +9,17 @@ export const Tag = {
   MeshFile: 3,
   SelectionFile: 4,
   SceneFile: 5,
+  CompanionFile: 6,
   Mesh: 101,
   FrameResult: 102,
   File: 103,
   SelectionResult: 104,
   Preview: 105,
+  Appearance: 106,
+  Texture: 107,
 } as const;
 
-export type FileTag = typeof Tag.MeshFile | typeof Tag.SelectionFile | typeof Tag.SceneFile;
+export type FileTag = typeof Tag.MeshFile | typeof Tag.SelectionFile | typeof Tag.SceneFile | typeof Tag.CompanionFile;
 
 export type Matrix = number[]; // 4 x 4, row-major
 
@@ -89,7 +92,13 @@ export interface ErrorMessage {
   cancelled: boolean;
 }
 
-export type ServerText = ProgressMessage | ReadyMessage | StateMessage | ErrorMessage | { type: 'empty'; request: string };
+export type ServerText =
+  | ProgressMessage
+  | ReadyMessage
+  | StateMessage
+  | ErrorMessage
+  | { type: 'empty'; request: string }
+  | { type: 'note'; message: string }; // what an export dropped or changed
 
 // ---------------------------------------------------------------- JSON, browser -> server
 
@@ -97,7 +106,9 @@ export type ClientText =
   | { type: 'hello' | 'open_demo' | 'commit' | 'undo' | 'redo' | 'apply_pose' | 'export_scene' | 'cancel' }
   | ({ type: 'settings' } & Partial<Settings> & { modes?: number })
   | { type: 'preview'; vertices: number }
-  | { type: 'export_mesh'; format: 'obj' | 'off' | 'ply' | 'stl' };
+  | { type: 'export_mesh'; format?: ExportFormat }; // none: the opened file's own
+
+export type ExportFormat = 'obj' | 'off' | 'ply' | 'stl' | 'gltf' | 'glb';
 
 // ---------------------------------------------------------------- binary
 
@@ -131,6 +142,25 @@ export interface FrameResult {
   // preview): 16 bits a coordinate.
   scale: number;
   displacements: Int16Array; // 3 n
+}
+
+// The file's look (apps/server/appearance.h): the mesh's triangles over render vertices (a mesh
+// vertex with one texture coordinate and normal group), sorted by material.
+export interface AppearanceMessage {
+  vertex: Uint32Array; // mesh vertex of each render vertex
+  normalGroup: Uint32Array; // render vertices of a group share their normal
+  indices: Uint32Array; // 3 T, render numbering
+  materialStart: Uint32Array; // material m's triangles [start[m], start[m + 1]); the last: none
+  baseColor: Float32Array; // RGBA of each material
+  textured: Uint32Array; // 1: the material has an image (a texture message follows)
+  uv: Float32Array | null; // 2 per render vertex, v up
+  rgba: Uint8Array | null; // 4 per render vertex
+}
+
+export interface TextureMessage {
+  material: number;
+  mime: string;
+  image: Uint8Array;
 }
 
 export interface NamedFile {
@@ -241,4 +271,31 @@ export function decodeFrameResult(buffer: ArrayBuffer): FrameResult {
     scale: new Float32Array(buffer, 48, 1)[0],
     displacements: new Int16Array(buffer, 52, 3 * u[2]),
   };
+}
+
+export function decodeAppearance(buffer: ArrayBuffer): AppearanceMessage {
+  const [, R, T, M, flags] = new Uint32Array(buffer, 0, 5);
+  let at = 20;
+  const u32 = (count: number) => {
+    const a = new Uint32Array(buffer, at, count);
+    at += 4 * count;
+    return a;
+  };
+  const vertex = u32(R), normalGroup = u32(R), indices = u32(3 * T), materialStart = u32(M + 2);
+  const baseColor = new Float32Array(buffer, at, 4 * M);
+  at += 16 * M;
+  const textured = u32(M);
+  let uv: Float32Array | null = null;
+  if (flags & 1) {
+    uv = new Float32Array(buffer, at, 2 * R);
+    at += 8 * R;
+  }
+  const rgba = flags & 2 ? new Uint8Array(buffer, at, 4 * R) : null;
+  return { vertex, normalGroup, indices, materialStart, baseColor, textured, uv, rgba };
+}
+
+export function decodeTexture(buffer: ArrayBuffer): TextureMessage {
+  const [, material, length] = new Uint32Array(buffer, 0, 3);
+  const mime = new TextDecoder().decode(new Uint8Array(buffer, 12, length));
+  return { material, mime, image: new Uint8Array(buffer, 12 + Math.ceil(length / 4) * 4) };
 }

@@ -83,6 +83,7 @@ export class EditorState {
   private restorePending = false; // a restored selection is on its way back
 
   constructor(readonly viewer: Viewer) {
+    viewer.freeColor = FREE_COLOR;
     this.connection = new Connection(`ws://${location.host}/ws`, {
       status: (s) => this.onStatus(s),
       text: (m) => this.onText(m),
@@ -249,6 +250,9 @@ export class EditorState {
         this.adoptState(m);
         if (this.phase.kind !== 'busy' || this.phase.expects !== 'file') this.phase = { kind: 'ready' };
         break;
+      case 'note':
+        this.note(m.message);
+        break;
       case 'empty':
         if (STATE_REQUESTS.has(m.request)) this.awaitingStates = Math.max(0, this.awaitingStates - 1);
         this.phase = { kind: 'empty' };
@@ -300,6 +304,22 @@ export class EditorState {
       }
       case P.Tag.SelectionResult:
         return this.adoptSelection(P.decodeSelection(buffer));
+      case P.Tag.Appearance: {
+        const a = P.decodeAppearance(buffer);
+        this.viewer.setAppearance(a);
+        this.post({ kind: 'look', vertex: a.vertex.slice(), group: a.normalGroup.slice(), indices: a.indices.slice() });
+        // The shown frame again, with the look's normals.
+        const f = this.frame;
+        if (f && !f.preview && f.displacements.length === this.rest.length) {
+          return this.computeFrame('full', f.seq, f.scale, f.displacements);
+        }
+        return this.showRest();
+      }
+      case P.Tag.Texture: {
+        const t = P.decodeTexture(buffer);
+        this.viewer.setTexture(t.material, t.mime, t.image.slice()).catch((e) => this.note(`texture: ${e}`, 'error'));
+        return;
+      }
     }
   }
 
@@ -324,7 +344,7 @@ export class EditorState {
     this.normalsBusy[m.slot] = false;
     const newer = m.slot === 'full' || !this.fullAfter(m.seq);
     if (m.slot === 'full') {
-      this.viewer.setPositions(m.positions, m.normals);
+      this.viewer.setPositions(m.positions, m.normals, m.lookNormals);
       this.measures = m.measures;
     }
     else if (newer) this.viewer.showPreview(m.positions, m.normals);

@@ -7,6 +7,8 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TransformControls } from 'three/addons/controls/TransformControls.js';
 import { MeshBVH } from 'three-mesh-bvh';
+import { FileLook } from './look';
+import type { AppearanceMessage } from './protocol';
 
 export interface Hit {
   point: THREE.Vector3;
@@ -20,6 +22,9 @@ export class Viewer {
   readonly orbit: OrbitControls;
   readonly gizmo: TransformControls;
   readonly pivot = new THREE.Object3D(); // what the gizmo moves
+  readonly look = new FileLook(); // the file's texture, colours and normals, when it has them
+  freeColor = new THREE.Color(); // the colour of vertices no selection holds (the file's own show)
+  private lookShown = true;
   onRendered: () => void = () => {};
 
   readonly scene = new THREE.Scene();
@@ -82,7 +87,7 @@ export class Viewer {
       new THREE.LineBasicMaterial({ vertexColors: true, depthTest: false, transparent: true }));
     this.cursorMark.visible = false;
     this.cursorMark.renderOrder = 2;
-    this.scene.add(this.surface, this.coarse, this.wireframe, this.pivot, this.ring, this.cursorMark);
+    this.scene.add(this.surface, this.look.mesh, this.coarse, this.wireframe, this.pivot, this.ring, this.cursorMark);
     this.previewLabel = Object.assign(document.createElement('div'), {
       id: 'preview-label', textContent: 'preview; detail on release', hidden: true });
     this.axes = Object.assign(document.createElement('canvas'), { id: 'axes', width: 96, height: 96,
@@ -124,7 +129,8 @@ export class Viewer {
     this.bvh = new MeshBVH(this.geometry);
     this.bvhStale = false;
     this.coarse.visible = false;
-    this.surface.visible = true;
+    if (!keepCamera) this.look.set(null); // another mesh: its look, if any, follows
+    this.showSurface();
     if (!keepCamera) {
       const sphere = this.geometry.boundingSphere!;
       this.camera.near = sphere.radius / 100;
@@ -141,8 +147,40 @@ export class Viewer {
     return this.geometry.getAttribute('position').array as Float32Array;
   }
 
-  // A full frame: positions and their normals (computed off the main thread).
-  setPositions(positions: Float32Array, normals: Float32Array): void {
+  // The file's look (after its mesh), or none.
+  setAppearance(a: AppearanceMessage | null): void {
+    this.look.set(a);
+    this.look.setPositions(this.positions(), null);
+    this.look.setColors(this.geometry.getAttribute('color').array as Float32Array, this.freeColor);
+    this.showSurface();
+    this.requestRender();
+  }
+
+  async setTexture(material: number, mime: string, image: Uint8Array): Promise<void> {
+    await this.look.setTexture(material, mime, image);
+    this.requestRender();
+  }
+
+  // Whether the file's look is drawn (where it has one) or the plain surface.
+  showLook(on: boolean): void {
+    this.lookShown = on;
+    this.showSurface();
+    this.requestRender();
+  }
+
+  get drawingLook(): boolean {
+    return this.look.mesh.visible;
+  }
+
+  private showSurface(): void {
+    const look = this.look.present && this.lookShown;
+    this.look.mesh.visible = look;
+    this.surface.visible = !look;
+  }
+
+  // A full frame: positions and their normals (computed off the main thread), and the file
+  // look's normals when it has one.
+  setPositions(positions: Float32Array, normals: Float32Array, lookNormals: Float32Array | null = null): void {
     const p = this.geometry.getAttribute('position') as THREE.BufferAttribute;
     (p.array as Float32Array).set(positions);
     p.needsUpdate = true;
@@ -151,7 +189,8 @@ export class Viewer {
     nrm.needsUpdate = true;
     this.bvhStale = true;
     this.coarse.visible = false;
-    this.surface.visible = true;
+    this.look.setPositions(positions, lookNormals);
+    this.showSurface();
     this.previewLabel.hidden = true;
     this.requestRender();
   }
@@ -179,6 +218,7 @@ export class Viewer {
     }
     attribute.needsUpdate = true;
     this.syncCoarseColors();
+    this.look.setColors(array, this.freeColor);
     this.requestRender();
   }
 
@@ -206,6 +246,7 @@ export class Viewer {
     p.needsUpdate = nrm.needsUpdate = true;
     this.coarse.visible = true;
     this.surface.visible = false;
+    this.look.mesh.visible = false;
     this.previewLabel.hidden = false;
     this.requestRender();
   }

@@ -111,8 +111,9 @@ Selection radius_selection(const TriangleMesh& mesh, int center, double radius,
 Scene benchmark_scene(const TriangleMesh& mesh);
 
 // From file vertex indices to the loaded mesh's, leaving out the vertices the reader dropped
-// (used by no face). A handle group or fixed set that loses all its vertices is an InputError
-// naming it, `name` (the scene's) first; one that loses some adds a line to `notes`, if given
+// (used by no face); copies of one welded vertex (a glTF file's seams) count once. A handle group
+// or fixed set that loses all its vertices is an InputError naming it, `name` (the scene's) first;
+// one that loses some adds a line to `notes`, if given
 // ("handle group 0: 3 of its 40 vertices are used by no face and were left out").
 Selection to_mesh_numbering(const Selection& selection, const MeshReadInfo& info,
                             std::vector<std::string>* notes = nullptr,

@@ -1,0 +1,161 @@
+#include "file_normals.h"
+
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "linalg/nearest_rotation.h"
+
+namespace specdeform::detail {
+
+namespace {
+
+using Vec = Eigen::Vector3d;
+
+// A polygon corner's triangle: its vertex, the next and the previous corner's.
+struct Corner {
+  int v, next, prev;
+};
+
+template <typename Visit>
+void for_each_corner(const FileAttributes& a, const Visit& visit) {
+  for (int p = 0; p < a.num_polygons(); ++p) {
+    const int begin = a.offsets[p], k = a.offsets[p + 1] - begin;
+    for (int c = 0; c < k; ++c) {
+      visit(p, begin + c,
+            Corner{a.corners[begin + c], a.corners[begin + (c + 1) % k],
+                   a.corners[begin + (c + k - 1) % k]});
+    }
+  }
+}
+
+// The corner's frame [e1 e2 n] (n the unit normal of e1 x e2); false where degenerate.
+bool frame(const Vertices& X, const Corner& c, Eigen::Matrix3d& out) {
+  const Vec e1 = X.row(c.next) - X.row(c.v), e2 = X.row(c.prev) - X.row(c.v);
+  const Vec n = e1.cross(e2);
+  const double scale = e1.squaredNorm() * e2.squaredNorm();
+  if (!(n.squaredNorm() > 1e-24 * scale)) return false;
+  out << e1, e2, n.normalized();
+  return true;
+}
+
+double angle(const Eigen::Matrix3d& frame) {
+  return std::atan2(frame.col(0).cross(frame.col(1)).norm(), frame.col(0).dot(frame.col(1)));
+}
+
+// Polygons with a corner away from its rest position.
+std::vector<char> moved_polygons(const FileAttributes& a, const Vertices& rest,
+                                 const Vertices& deformed) {
+  std::vector<char> moved(a.num_polygons(), 0);
+  for_each_corner(a, [&](int p, int, const Corner& c) {
+    if (rest.row(c.v) != deformed.row(c.v)) moved[p] = 1;
+  });
+  return moved;
+}
+
+// Per row: the sum of each corner's `contribution` (a vector) times its weight, over the corners
+// of moved polygons that use the row; `used` says which rows have such a corner.
+template <typename Contribution>
+Eigen::MatrixX3d sum_over_corners(const FileAttributes& a, const std::vector<int>& rows,
+                                  Eigen::Index count, const std::vector<char>& moved,
+                                  std::vector<char>& used, const Contribution& contribution) {
+  Eigen::MatrixX3d sum = Eigen::MatrixX3d::Zero(count, 3);
+  used.assign(count, 0);
+  for_each_corner(a, [&](int p, int corner, const Corner& c) {
+    const int row = rows[corner];
+    if (row < 0 || !moved[p]) return;
+    used[row] = 1;
+    sum.row(row) += contribution(c, row).transpose();
+  });
+  return sum;
+}
+
+Eigen::MatrixX3d recomputed(const FileAttributes& a, const Vertices& deformed,
+                            const std::vector<char>& moved, std::vector<char>& used) {
+  return sum_over_corners(a, a.corner_normal, a.normals.rows(), moved, used,
+                          [&](const Corner& c, int) -> Vec {
+                            Eigen::Matrix3d d;
+                            if (!frame(deformed, c, d)) return Vec::Zero();
+                            return angle(d) * d.col(2);
+                          });
+}
+
+// Each vertex's rotation nearest to the map of its polygon edges at rest to their deformed ones.
+std::vector<Eigen::Matrix3d> vertex_rotations(const FileAttributes& a, const Vertices& rest,
+                                              const Vertices& deformed) {
+  std::vector<Eigen::Matrix3d> cov(rest.rows(), Eigen::Matrix3d::Zero());
+  for_each_corner(a, [&](int, int, const Corner& c) {
+    const Vec e = rest.row(c.next) - rest.row(c.v), d = deformed.row(c.next) - deformed.row(c.v);
+    cov[c.v] += d * e.transpose();
+    cov[c.next] += d * e.transpose();
+  });
+  for (Eigen::Matrix3d& r : cov) r = r.isZero() ? Eigen::Matrix3d::Identity() : nearest_rotation(r);
+  return cov;
+}
+
+}  // namespace
+
+Eigen::MatrixX3d updated_normals(const FileAttributes& a, const Vertices& rest,
+                                 const Vertices& deformed, NormalUpdate mode) {
+  const std::vector<char> moved = moved_polygons(a, rest, deformed);
+  std::vector<char> used, used_recomputed;
+  Eigen::MatrixX3d sum;
+  if (mode == NormalUpdate::Follow) {
+    sum = sum_over_corners(
+        a, a.corner_normal, a.normals.rows(), moved, used, [&](const Corner& c, int row) -> Vec {
+          Eigen::Matrix3d r, d;
+          if (!frame(rest, c, r) || !frame(deformed, c, d)) return Vec::Zero();
+          // J^-T n = D^-T R^T n
+          const Vec n =
+              d.transpose().partialPivLu().solve(r.transpose() * a.normals.row(row).transpose());
+          return angle(d) * n.normalized();
+        });
+  } else if (mode == NormalUpdate::Rotate) {
+    const std::vector<Eigen::Matrix3d> rotation = vertex_rotations(a, rest, deformed);
+    sum = sum_over_corners(a, a.corner_normal, a.normals.rows(), moved, used,
+                           [&](const Corner& c, int row) -> Vec {
+                             return rotation[c.v] * a.normals.row(row).transpose();
+                           });
+  } else {
+    sum = recomputed(a, deformed, moved, used);
+  }
+  Eigen::MatrixX3d fallback;
+  Eigen::MatrixX3d out = a.normals;
+  for (Eigen::Index row = 0; row < out.rows(); ++row) {
+    if (!used[row]) continue;
+    double norm = sum.row(row).norm();
+    if (!(norm > 1e-12) && mode != NormalUpdate::Recompute) {
+      if (fallback.size() == 0) fallback = recomputed(a, deformed, moved, used_recomputed);
+      sum.row(row) = fallback.row(row);
+      norm = sum.row(row).norm();
+    }
+    if (norm > 1e-12) out.row(row) = sum.row(row) / norm;
+  }
+  return out;
+}
+
+Eigen::MatrixX3d updated_tangents(const FileAttributes& a, const Vertices& rest,
+                                  const Vertices& deformed, const Eigen::MatrixX3d& tangents,
+                                  const Eigen::MatrixX3d& normals) {
+  const std::vector<char> moved = moved_polygons(a, rest, deformed);
+  std::vector<char> used;
+  const Eigen::MatrixX3d sum = sum_over_corners(
+      a, a.corner_normal, tangents.rows(), moved, used, [&](const Corner& c, int row) -> Vec {
+        Eigen::Matrix3d r, d;
+        if (!frame(rest, c, r) || !frame(deformed, c, d)) return Vec::Zero();
+        // J t = D R^-1 t
+        const Vec t = d * r.partialPivLu().solve(tangents.row(row).transpose());
+        return angle(d) * t.normalized();
+      });
+  Eigen::MatrixX3d out = tangents;
+  for (Eigen::Index row = 0; row < out.rows(); ++row) {
+    if (!used[row]) continue;
+    const Vec n = normals.row(row).transpose();
+    const Vec t = sum.row(row).transpose() - n.dot(sum.row(row)) * n;
+    if (t.norm() > 1e-12) out.row(row) = t.normalized().transpose();
+  }
+  return out;
+}
+
+}  // namespace specdeform::detail

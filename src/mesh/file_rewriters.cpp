@@ -1,0 +1,237 @@
+#include "file_rewriters.h"
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+
+#include "float_cast.h"
+#include "text_rewriter.h"
+
+namespace specdeform::detail {
+
+namespace {
+
+template <typename Layout>
+const Layout& layout_of(const MeshFile& file) {
+  return std::get<Layout>(file.layout->format);
+}
+
+}  // namespace
+
+std::string rewrite_obj(const MeshFile& file, const Vertices& positions,
+                        const Eigen::MatrixX3d& normals) {
+  const ObjLayout& layout = layout_of<ObjLayout>(file);
+  TextRewriter out(file.layout->bytes);
+  // The v and vn lines in file order.
+  size_t v = 0, vn = 0;
+  const size_t nv = layout.v.size(), nn = normals.rows() > 0 ? layout.vn.size() : 0;
+  while (v < nv || vn < nn) {
+    if (vn >= nn || (v < nv && layout.v[v] < layout.vn[vn])) {
+      out.seek(layout.v[v]);
+      for (int k = 0; k < 3; ++k) out.replace(positions(Eigen::Index(v), k), NumberText::Auto);
+      ++v;
+    } else {
+      out.seek(layout.vn[vn]);
+      for (int k = 0; k < 3; ++k) out.replace(normals(Eigen::Index(vn), k), NumberText::Float);
+      ++vn;
+    }
+  }
+  return out.finish();
+}
+
+std::string rewrite_off(const MeshFile& file, const Vertices& positions,
+                        const Eigen::MatrixX3d& normals) {
+  const OffLayout& layout = layout_of<OffLayout>(file);
+  TextRewriter out(file.layout->bytes);
+  for (size_t i = 0; i < layout.vertex.size(); ++i) {
+    out.seek(layout.vertex[i]);
+    for (int k = 0; k < 3; ++k) out.replace(positions(Eigen::Index(i), k), NumberText::Auto);
+    if (layout.normals && normals.rows() > 0) {
+      for (int k = 0; k < 3; ++k) out.replace(normals(Eigen::Index(i), k), NumberText::Float);
+    }
+  }
+  return out.finish();
+}
+
+namespace {
+
+NumberText text_style(PlyScalar s) {
+  return s == PlyScalar::F32   ? NumberText::Float
+         : s == PlyScalar::F64 ? NumberText::Double
+                               : NumberText::Integer;
+}
+
+// A binary value of type `s` at `at`: read as a double, or written from one (rounded for integer
+// types). Only a value that differs is written, so that an unchanged one keeps its bytes (-0.0,
+// NaN payloads).
+class BinaryValue {
+ public:
+  BinaryValue(std::string& bytes, bool big_endian) : bytes_(bytes), swap_(big_endian) {}
+
+  double get(size_t at, PlyScalar s) const {
+    unsigned char b[8];
+    load(at, ply_scalar_size(s), b);
+    switch (s) {
+      case PlyScalar::I8:
+        return as<int8_t>(b);
+      case PlyScalar::U8:
+        return as<uint8_t>(b);
+      case PlyScalar::I16:
+        return as<int16_t>(b);
+      case PlyScalar::U16:
+        return as<uint16_t>(b);
+      case PlyScalar::I32:
+        return as<int32_t>(b);
+      case PlyScalar::U32:
+        return as<uint32_t>(b);
+      case PlyScalar::F32:
+        return as<float>(b);
+      case PlyScalar::F64:
+        return as<double>(b);
+    }
+    return 0;
+  }
+
+  void set(size_t at, PlyScalar s, double v) {
+    switch (s) {
+      case PlyScalar::I8:
+        return put<int8_t>(at, s, v);
+      case PlyScalar::U8:
+        return put<uint8_t>(at, s, v);
+      case PlyScalar::I16:
+        return put<int16_t>(at, s, v);
+      case PlyScalar::U16:
+        return put<uint16_t>(at, s, v);
+      case PlyScalar::I32:
+        return put<int32_t>(at, s, v);
+      case PlyScalar::U32:
+        return put<uint32_t>(at, s, v);
+      case PlyScalar::F32:
+        return put<float>(at, s, v);
+      case PlyScalar::F64:
+        return put<double>(at, s, v);
+    }
+  }
+
+ private:
+  void load(size_t at, size_t size, unsigned char* b) const {
+    std::memcpy(b, bytes_.data() + at, size);
+    if (swap_ != (std::endian::native == std::endian::big))
+      for (size_t i = 0; i < size / 2; ++i) std::swap(b[i], b[size - 1 - i]);
+  }
+  template <typename T>
+  static double as(const unsigned char* b) {
+    T v;
+    std::memcpy(&v, b, sizeof v);
+    return static_cast<double>(v);
+  }
+  template <typename T>
+  void put(size_t at, PlyScalar s, double v) {
+    const T value = checked_cast<T>(v, "a PLY value");
+    const double stored = get(at, s);
+    if (static_cast<double>(value) == stored || (std::isnan(v) && std::isnan(stored))) return;
+    unsigned char b[sizeof(T)];
+    std::memcpy(b, &value, sizeof value);
+    if (swap_ != (std::endian::native == std::endian::big))
+      for (size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
+    std::memcpy(bytes_.data() + at, b, sizeof b);
+  }
+
+  std::string& bytes_;
+  bool swap_;
+};
+
+}  // namespace
+
+std::string rewrite_ply(const MeshFile& file, const Vertices& positions,
+                        const Eigen::MatrixX3d& normals) {
+  const PlyLayout& layout = layout_of<PlyLayout>(file);
+  const PlyElement& vertex = layout.elements[layout.vertex_element];
+  const bool write_normals = layout.normal[0] >= 0 && normals.rows() > 0;
+  // The value property p of vertex i gets, if any.
+  const auto value = [&](Eigen::Index i, int p, double& v, NumberText& style) {
+    for (int k = 0; k < 3; ++k) {
+      if (p == layout.xyz[k]) {
+        v = positions(i, k);
+        style = text_style(vertex.properties[p].type);
+        return true;
+      }
+      if (write_normals && p == layout.normal[k]) {
+        v = normals(i, k);
+        style = vertex.properties[p].type == PlyScalar::F64 ? NumberText::Double
+                                                            : text_style(vertex.properties[p].type);
+        return true;
+      }
+    }
+    return false;
+  };
+  if (layout.encoding == PlyEncoding::Ascii) {
+    TextRewriter out(file.layout->bytes);
+    for (size_t i = 0; i < layout.vertex.size(); ++i) {
+      out.seek(layout.vertex[i]);
+      for (int p = 0; p < int(vertex.properties.size()); ++p) {
+        const PlyProperty& property = vertex.properties[p];
+        double v;
+        NumberText style;
+        if (property.is_list) {
+          const double count = read_number(out.peek());
+          out.keep(1 + (count >= 0 ? static_cast<long long>(count) : 0));
+        } else if (value(Eigen::Index(i), p, v, style)) {
+          out.replace(v, style);
+        } else {
+          out.keep(1);
+        }
+      }
+    }
+    return out.finish();
+  }
+  std::string bytes = file.layout->bytes;
+  BinaryValue binary(bytes, layout.encoding == PlyEncoding::Big);
+  for (size_t i = 0; i < layout.vertex.size(); ++i) {
+    size_t at = layout.vertex[i];
+    for (int p = 0; p < int(vertex.properties.size()); ++p) {
+      const PlyProperty& property = vertex.properties[p];
+      double v;
+      NumberText style;
+      if (property.is_list) {
+        const double count = binary.get(at, property.count_type);
+        at += ply_scalar_size(property.count_type) + size_t(count) * ply_scalar_size(property.type);
+        continue;
+      }
+      if (value(Eigen::Index(i), p, v, style)) binary.set(at, property.type, v);
+      at += ply_scalar_size(property.type);
+    }
+  }
+  return bytes;
+}
+
+std::string rewrite_stl(const MeshFile& file, const Vertices& positions,
+                        const Eigen::MatrixX3d& normals) {
+  const StlLayout& layout = layout_of<StlLayout>(file);
+  const FileAttributes& a = file.attributes;
+  if (layout.ascii) {
+    TextRewriter out(file.layout->bytes);
+    for (int f = 0; f < a.num_polygons(); ++f) {
+      out.seek(layout.facet_normal[f]);
+      for (int k = 0; k < 3; ++k) out.replace(normals(f, k), NumberText::Float);
+      for (int c = a.offsets[f]; c < a.offsets[f + 1]; ++c) {
+        out.seek(layout.corner[c]);
+        for (int k = 0; k < 3; ++k) out.replace(positions(a.corners[c], k), NumberText::Float);
+      }
+    }
+    return out.finish();
+  }
+  std::string bytes = file.layout->bytes;
+  BinaryValue binary(bytes, false);
+  for (int f = 0; f < a.num_polygons(); ++f) {
+    const size_t record = 84 + 50 * size_t(f);
+    for (int k = 0; k < 3; ++k) binary.set(record + 4 * k, PlyScalar::F32, normals(f, k));
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 3; ++k)
+        binary.set(record + 12 * (c + 1) + 4 * k, PlyScalar::F32,
+                   positions(a.corners[a.offsets[f] + c], k));
+  }
+  return bytes;
+}
+
+}  // namespace specdeform::detail

@@ -1,0 +1,106 @@
+#include "text_rewriter.h"
+
+#include <charconv>
+#include <cmath>
+
+namespace specdeform::detail {
+
+namespace {
+
+bool is_blank(char c) {
+  return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f';
+}
+
+int significant_digits(std::string_view t) {
+  int digits = 0;
+  bool leading = true;
+  for (const char c : t) {
+    if (c == 'e' || c == 'E') break;
+    if (c < '0' || c > '9') continue;
+    if (c != '0') leading = false;
+    if (!leading) ++digits;
+  }
+  return digits;
+}
+
+}  // namespace
+
+double read_number(std::string_view token) {
+  double v = std::nan("");
+  const char* begin = token.data() + (token.starts_with('+') ? 1 : 0);
+  std::from_chars(begin, token.data() + token.size(), v);
+  return v;
+}
+
+TextRewriter::TextRewriter(std::string_view source) : source_(source) {
+  out_.reserve(source.size() + source.size() / 4);
+}
+
+void TextRewriter::seek(size_t offset) {
+  if (offset <= pos_) return;
+  out_.append(source_.substr(pos_, offset - pos_));
+  pos_ = offset;
+}
+
+size_t TextRewriter::token_start(size_t from) const {
+  size_t p = from;
+  while (p < source_.size() && is_blank(source_[p])) ++p;
+  return p;
+}
+
+size_t TextRewriter::token_end(size_t start) const {
+  size_t p = start;
+  while (p < source_.size() && !is_blank(source_[p]) && source_[p] != '#') ++p;
+  return p;
+}
+
+std::string_view TextRewriter::peek() const {
+  const size_t start = token_start(pos_);
+  return source_.substr(start, token_end(start) - start);
+}
+
+void TextRewriter::keep(long long count) {
+  size_t p = pos_;
+  for (long long k = 0; k < count; ++k) p = token_end(token_start(p));
+  seek(p);
+}
+
+void TextRewriter::replace(double value, NumberText style) {
+  const size_t start = token_start(pos_);
+  seek(start);
+  const size_t end = token_end(start);
+  const std::string_view token = source_.substr(start, end - start);
+  const double old = read_number(token);
+  if (style == NumberText::Auto) {
+    style = significant_digits(token) <= 9 ? NumberText::Float : NumberText::Double;
+  }
+  char buf[40];
+  std::to_chars_result written{};
+  // The token stays where it reads back as the value (exactly, or in its style's precision).
+  bool same = value == old || (std::isnan(value) && std::isnan(old));
+  switch (style) {
+    case NumberText::Float:
+      same = same || static_cast<float>(value) == static_cast<float>(old);
+      written = std::to_chars(buf, buf + sizeof buf, static_cast<float>(value));
+      break;
+    case NumberText::Integer:
+      same = same || std::llround(value) == old;
+      written = std::to_chars(buf, buf + sizeof buf, std::llround(value));
+      break;
+    default:
+      written = std::to_chars(buf, buf + sizeof buf, value);
+  }
+  if (same) {
+    out_.append(token);
+  } else {
+    out_.append(buf, written.ptr);
+  }
+  pos_ = end;
+}
+
+std::string TextRewriter::finish() {
+  seek(source_.size());
+  return std::move(out_);
+}
+
+}  // namespace specdeform::detail

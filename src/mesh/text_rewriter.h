@@ -1,0 +1,45 @@
+// Internal: a text file copied with some of its numbers replaced (the same-format writers of
+// the text formats). Tokens are separated by blanks and line ends; '#' ends a token.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+namespace specdeform::detail {
+
+enum class NumberText {
+  Auto,     // as Float where the file's own number has 9 significant digits or fewer, else Double
+  Float,    // the shortest text that reads back to the same float32
+  Double,   // the shortest text that reads back to the same double
+  Integer,  // rounded to the nearest integer
+};
+
+// A token as the text readers read it (a leading '+' allowed); NaN for anything else.
+double read_number(std::string_view token);
+
+class TextRewriter {
+ public:
+  explicit TextRewriter(std::string_view source);
+
+  // Copies the source up to `offset` (not before the current position).
+  void seek(size_t offset);
+  // The next token (after blanks) without moving; empty at the end.
+  std::string_view peek() const;
+  // Copies the next `count` tokens and the blanks before them.
+  void keep(long long count);
+  // Copies the blanks, then writes `value` in place of the next token, or the token itself where
+  // it reads back as `value` written in `style`.
+  void replace(double value, NumberText style);
+  // The rest of the source appended; the text.
+  std::string finish();
+
+ private:
+  size_t token_start(size_t from) const;
+  size_t token_end(size_t start) const;
+
+  std::string_view source_;
+  size_t pos_ = 0;
+  std::string out_;
+};
+
+}  // namespace specdeform::detail

@@ -1,0 +1,409 @@
+// glTF read through tinygltf and written back byte for byte but POSITION (with its min and max),
+// NORMAL and TANGENT, on files built here as exporters write them.
+#include <tiny_gltf.h>
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include "specdeform/exceptions.h"
+#include "specdeform/mesh/io.h"
+#include "specdeform/mesh/mesh_file.h"
+
+namespace specdeform {
+namespace {
+
+using Json = nlohmann::json;
+
+// A scene as exporters write one: a cube split into 24 vertices (a normal, uv and tangent per
+// side), POSITION and NORMAL interleaved in one buffer view, drawn by a node under a turned and
+// shifted parent; a triangle under a mirroring node; a line primitive; a mesh no node draws; an
+// image in a buffer view; extras.
+struct TestScene {
+  tinygltf::Model model;
+
+  TestScene() {
+    model.asset.version = "2.0";
+    model.buffers.emplace_back();
+    // The cube: per side 4 vertices.
+    std::vector<float> interleaved, uv, tangent;
+    std::vector<uint16_t> indices;
+    for (int axis = 0; axis < 3; ++axis) {
+      for (const int sign : {-1, 1}) {
+        Eigen::Vector3f n = Eigen::Vector3f::Zero();
+        n[axis] = float(sign);
+        const Eigen::Vector3f u = Eigen::Vector3f::Unit((axis + 1) % 3) * float(sign);
+        const Eigen::Vector3f v = n.cross(u);
+        const uint16_t first = uint16_t(interleaved.size() / 6);
+        for (const auto& [a, b] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
+          const Eigen::Vector3f p = n + float(a) * u + float(b) * v;
+          interleaved.insert(interleaved.end(), {p.x(), p.y(), p.z(), n.x(), n.y(), n.z()});
+          uv.insert(uv.end(), {0.5f * (a + 1), 0.5f * (1 - b)});
+          tangent.insert(tangent.end(), {u.x(), u.y(), u.z(), 1.0f});
+        }
+        for (const int c : {0, 1, 2, 0, 2, 3}) indices.push_back(uint16_t(first + c));
+      }
+    }
+    const int cube_pn = view(interleaved, 24);
+    const int position =
+        accessor(cube_pn, 0, 24, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT);
+    model.accessors[position].minValues = {-1, -1, -1};
+    model.accessors[position].maxValues = {1, 1, 1};
+    const int normal = accessor(cube_pn, 12, 24, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT);
+    const int texcoord =
+        accessor(view(uv), 0, 24, TINYGLTF_TYPE_VEC2, TINYGLTF_COMPONENT_TYPE_FLOAT);
+    const int tangents =
+        accessor(view(tangent), 0, 24, TINYGLTF_TYPE_VEC4, TINYGLTF_COMPONENT_TYPE_FLOAT);
+    const int index = accessor(view(indices), 0, 36, TINYGLTF_TYPE_SCALAR,
+                               TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+    tinygltf::Primitive cube;
+    cube.attributes = {{"POSITION", position},
+                       {"NORMAL", normal},
+                       {"TEXCOORD_0", texcoord},
+                       {"TANGENT", tangents}};
+    cube.indices = index;
+    cube.mode = TINYGLTF_MODE_TRIANGLES;
+    tinygltf::Primitive line;
+    line.attributes = {{"POSITION", position}};
+    line.mode = TINYGLTF_MODE_LINE;
+    model.meshes.emplace_back();
+    model.meshes[0].name = "cube";
+    model.meshes[0].primitives = {cube, line};
+    // A triangle, non-indexed.
+    const std::vector<float> triangle = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    tinygltf::Primitive tri;
+    tri.attributes = {{"POSITION", accessor(view(triangle), 0, 3, TINYGLTF_TYPE_VEC3,
+                                            TINYGLTF_COMPONENT_TYPE_FLOAT)}};
+    model.accessors.back().minValues = {0, 0, 0};
+    model.accessors.back().maxValues = {1, 1, 0};
+    tri.mode = TINYGLTF_MODE_TRIANGLES;
+    model.meshes.emplace_back();
+    model.meshes[1].primitives = {tri};
+    model.meshes.push_back(model.meshes[1]);  // drawn by no node
+    // An image in a buffer view.
+    const std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', 1, 2, 3, 4};
+    tinygltf::Image image;
+    image.bufferView = view(png);
+    image.mimeType = "image/png";
+    model.images.push_back(image);
+    // Nodes: 0 turned and shifted, its child 1 draws the cube; 2 mirrors the triangle.
+    tinygltf::Node parent, child, mirror;
+    parent.rotation = {0, 0, std::sin(0.3), std::cos(0.3)};
+    parent.translation = {1, 2, 3};
+    parent.children = {1};
+    child.mesh = 0;
+    child.scale = {2, 2, 2};
+    mirror.mesh = 1;
+    mirror.matrix = {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 5, 0, 0, 1};
+    model.nodes = {parent, child, mirror};
+    model.scenes.emplace_back();
+    model.scenes[0].nodes = {0, 2};
+    model.defaultScene = 0;
+    model.extras = tinygltf::Value(tinygltf::Value::Object{{"note", tinygltf::Value("kept")}});
+  }
+
+  template <typename T>
+  int view(const std::vector<T>& data, int stride = 0) {
+    std::vector<unsigned char>& b = model.buffers[0].data;
+    while (b.size() % 4) b.push_back(0);
+    tinygltf::BufferView v;
+    v.buffer = 0;
+    v.byteOffset = b.size();
+    v.byteLength = data.size() * sizeof(T);
+    v.byteStride = stride;
+    const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
+    b.insert(b.end(), bytes, bytes + v.byteLength);
+    model.bufferViews.push_back(v);
+    return int(model.bufferViews.size()) - 1;
+  }
+
+  int accessor(int view, size_t offset, size_t count, int type, int component) {
+    tinygltf::Accessor a;
+    a.bufferView = view;
+    a.byteOffset = offset;
+    a.count = count;
+    a.type = type;
+    a.componentType = component;
+    model.accessors.push_back(a);
+    return int(model.accessors.size()) - 1;
+  }
+
+  std::string glb() const {
+    std::ostringstream out;
+    tinygltf::TinyGLTF writer;
+    EXPECT_TRUE(writer.WriteGltfSceneToStream(&model, out, false, true));
+    return out.str();
+  }
+  std::string embedded() const {
+    std::ostringstream out;
+    tinygltf::TinyGLTF writer;
+    EXPECT_TRUE(writer.WriteGltfSceneToStream(&model, out, true, false));
+    return out.str();
+  }
+};
+
+LoadedMesh keep(const std::string& bytes, MeshFormat format, FileResolver companions = {}) {
+  return read_mesh_from_memory(bytes, format, "test",
+                               {.keep_file = true, .companions = companions});
+}
+
+// The chunks of a .glb: JSON, BIN.
+std::pair<Json, std::string> chunks(const std::string& glb) {
+  uint32_t json_length;
+  std::memcpy(&json_length, glb.data() + 12, 4);
+  uint32_t bin_length;
+  std::memcpy(&bin_length, glb.data() + 20 + json_length, 4);
+  return {Json::parse(glb.substr(20, json_length)), glb.substr(28 + json_length, bin_length)};
+}
+
+Eigen::Matrix4d cube_world() {
+  Eigen::Affine3d t = Eigen::Affine3d::Identity();
+  t.translate(Eigen::Vector3d(1, 2, 3));
+  t.rotate(Eigen::AngleAxisd(0.6, Eigen::Vector3d::UnitZ()));
+  t.scale(2.0);
+  return t.matrix();
+}
+
+TEST(Gltf, NumberingWeldingAndWorldSpace) {
+  const TestScene scene;
+  const LoadedMesh m = keep(scene.glb(), MeshFormat::Glb);
+  // The cube's 24 POSITION vertices, then the triangle's 3; no line, no undrawn mesh.
+  ASSERT_EQ(m.info.file_vertices.rows(), 27);
+  EXPECT_EQ(m.mesh.num_vertices(), 8 + 3);
+  EXPECT_EQ(m.mesh.num_faces(), 12 + 1);
+  EXPECT_EQ(m.info.welded_vertices, 16);
+  const Eigen::Matrix4d world = cube_world();
+  const auto& p = scene.model.buffers[0].data;
+  for (int v = 0; v < 24; ++v) {
+    float local[3];
+    std::memcpy(local, p.data() + 24 * v, 12);
+    const Eigen::Vector4d w = world * Eigen::Vector4d(local[0], local[1], local[2], 1);
+    EXPECT_LT((m.info.file_vertices.row(v).transpose() - w.head<3>()).norm(), 1e-12);
+    // Copies share their mesh vertex.
+    for (int u = 0; u < v; ++u) {
+      if (m.info.file_vertices.row(u) == m.info.file_vertices.row(v))
+        EXPECT_EQ(m.info.file_to_vertex[u], m.info.file_to_vertex[v]);
+    }
+  }
+  // The closed cube faces outwards; the mirrored triangle is turned to face +z in world space
+  // as it does in its own.
+  double volume = 0;
+  for (int f = 0; f < 12; ++f) {
+    const Eigen::Vector3d a = m.mesh.V.row(m.mesh.F(f, 0)), b = m.mesh.V.row(m.mesh.F(f, 1)),
+                          c = m.mesh.V.row(m.mesh.F(f, 2));
+    volume += a.dot(b.cross(c)) / 6;
+  }
+  EXPECT_NEAR(volume, 64.0, 1e-9);
+  const auto& V = m.mesh.V;
+  const Eigen::RowVector3i t = m.mesh.F.row(12);
+  const Eigen::Vector3d n = (V.row(t[1]) - V.row(t[0])).cross(V.row(t[2]) - V.row(t[0]));
+  EXPECT_GT(n.z(), 0);
+  EXPECT_EQ(V.row(t[0]).x() + V.row(t[1]).x() + V.row(t[2]).x(), 14.0);  // 5 - x, mirrored
+  const FileSummary s = m.file->summary();
+  EXPECT_EQ(s.meshes, 2);
+  EXPECT_EQ(s.primitives, 2);
+  EXPECT_EQ(s.images, 1);
+}
+
+TEST(Gltf, IdentityIsByteForByte) {
+  const TestScene scene;
+  for (const MeshFormat format : {MeshFormat::Glb, MeshFormat::Gltf}) {
+    const std::string bytes = format == MeshFormat::Glb ? scene.glb() : scene.embedded();
+    const LoadedMesh m = keep(bytes, format);
+    const EncodedMesh out =
+        encode_mesh_file(*m.file, m.file->rest, format == MeshFormat::Glb ? "o.glb" : "o.gltf");
+    ASSERT_EQ(out.files.size(), 1u);
+    EXPECT_EQ(out.files[0].bytes, bytes);
+  }
+}
+
+// A rigid motion in world space: positions there, normals and tangents turned (w kept), min and
+// max updated; the rest of the JSON and every other byte as it was.
+TEST(Gltf, MovedRewritesOnlyPositionsNormalsTangents) {
+  const TestScene scene;
+  const std::string glb = scene.glb();
+  const LoadedMesh m = keep(glb, MeshFormat::Glb);
+  Eigen::Affine3d motion = Eigen::Affine3d::Identity();
+  motion.translate(Eigen::Vector3d(-2, 0.5, 1));
+  motion.rotate(Eigen::AngleAxisd(1.1, Eigen::Vector3d(1, 1, 0).normalized()));
+  const Vertices X =
+      (m.file->rest * motion.linear().transpose()).rowwise() + motion.translation().transpose();
+  const std::string out = encode_mesh_file(*m.file, X, "o.glb").files[0].bytes;
+  const LoadedMesh back = keep(out, MeshFormat::Glb);
+  EXPECT_LT((back.file->rest - X).cwiseAbs().maxCoeff(), 1e-5);
+  const Eigen::MatrixX3d turned = m.file->attributes.normals * motion.linear().transpose();
+  EXPECT_LT((back.file->attributes.normals.topRows(24) - turned.topRows(24)).cwiseAbs().maxCoeff(),
+            1e-6);
+
+  auto [json_in, bin_in] = chunks(glb);
+  auto [json_out, bin_out] = chunks(out);
+  // Min and max: the new positions in the cube's own space.
+  const Eigen::Matrix4d to_local = cube_world().inverse();
+  Eigen::Array3d lo = Eigen::Array3d::Constant(1e300), hi = -lo;
+  for (int v = 0; v < 24; ++v) {
+    const Eigen::Vector4d local = to_local * Eigen::Vector4d(X(v, 0), X(v, 1), X(v, 2), 1);
+    lo = lo.min(local.head<3>().array());
+    hi = hi.max(local.head<3>().array());
+  }
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(json_out["accessors"][0]["min"][k].get<double>(), lo[k], 1e-6);
+    EXPECT_NEAR(json_out["accessors"][0]["max"][k].get<double>(), hi[k], 1e-6);
+  }
+  for (const int a : {0, 5}) {
+    json_in["accessors"][a].erase("min");
+    json_in["accessors"][a].erase("max");
+    json_out["accessors"][a].erase("min");
+    json_out["accessors"][a].erase("max");
+  }
+  EXPECT_EQ(json_in, json_out);
+  // Bytes: the cube's interleaved view (positions and normals), its tangents' xyz, the
+  // triangle's positions differ; its uv, tangents' w, indices, the undrawn mesh and the image do
+  // not.
+  ASSERT_EQ(bin_in.size(), bin_out.size());
+  const auto& views = json_in["bufferViews"];
+  const auto range = [&](int v) {
+    const size_t at = views[v].value("byteOffset", 0);
+    return std::pair{at, at + size_t(views[v]["byteLength"])};
+  };
+  std::vector<char> may_change(bin_in.size(), 0);
+  for (size_t i = range(0).first; i < range(0).second; ++i) may_change[i] = 1;
+  for (size_t i = range(2).first; i < range(2).second; ++i)
+    may_change[i] = (i - range(2).first) % 16 < 12;
+  for (size_t i = range(4).first; i < range(4).second; ++i) may_change[i] = 1;
+  int changed = 0;
+  for (size_t i = 0; i < bin_in.size(); ++i) {
+    if (!may_change[i]) {
+      ASSERT_EQ(bin_in[i], bin_out[i]) << "byte " << i;
+    } else {
+      changed += bin_in[i] != bin_out[i];
+    }
+  }
+  EXPECT_GT(changed, 100);
+  // Tangents turned with their faces (the cube's own space is turned by the same rotation's
+  // conjugate), w kept.
+  const Eigen::Matrix3d A = cube_world().topLeftCorner<3, 3>();
+  const Eigen::Matrix3d local_turn = A.inverse() * motion.linear() * A;
+  for (int v = 0; v < 24; ++v) {
+    float before[4], after[4];
+    std::memcpy(before, bin_in.data() + range(2).first + 16 * v, 16);
+    std::memcpy(after, bin_out.data() + range(2).first + 16 * v, 16);
+    const Eigen::Vector3d expected =
+        (local_turn * Eigen::Vector3f(before).cast<double>()).normalized();
+    EXPECT_LT((Eigen::Vector3f(after).cast<double>() - expected).norm(), 1e-6);
+    EXPECT_EQ(after[3], before[3]);
+  }
+}
+
+// A non-rigid deformation of the welded mesh: every copy of a vertex gets the same position.
+TEST(Gltf, SeamsStayClosed) {
+  const TestScene scene;
+  const LoadedMesh m = keep(scene.glb(), MeshFormat::Glb);
+  Vertices V = m.mesh.V;
+  for (int i = 0; i < V.rows(); ++i)
+    V.row(i) += Eigen::RowVector3d(std::sin(V(i, 1)), 0, V(i, 0) * 0.1);
+  const Vertices X = to_file_order(m.info, V, m.mesh.F).V;
+  const LoadedMesh back =
+      keep(encode_mesh_file(*m.file, X, "o.glb").files[0].bytes, MeshFormat::Glb);
+  EXPECT_EQ(back.mesh.num_vertices(), m.mesh.num_vertices());
+  for (int v = 0; v < 27; ++v)
+    EXPECT_LT((back.file->rest.row(v) - V.row(m.info.file_to_vertex[v])).norm(), 1e-5);
+}
+
+// A .gltf with its buffer beside it: the buffer is written under the output's name when the
+// output is beside the input, and found through the companions.
+TEST(Gltf, ExternalBuffer) {
+  const auto dir = std::filesystem::temp_directory_path() / "specdeform_gltf_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  TestScene scene;
+  scene.model.buffers[0].uri = "scene data.bin";
+  tinygltf::TinyGLTF writer;
+  ASSERT_TRUE(writer.WriteGltfSceneToFile(&scene.model, (dir / "scene.gltf").string(), false, false,
+                                          true, false));
+  ASSERT_TRUE(std::filesystem::exists(dir / "scene data.bin"));
+  const LoadedMesh m = read_mesh(dir / "scene.gltf", {.keep_file = true, .companions = {}});
+  EXPECT_EQ(m.info.file_vertices.rows(), 27);
+  const EncodedMesh same = encode_mesh_file(*m.file, m.file->rest, dir / "copy.gltf");
+  ASSERT_EQ(same.files.size(), 1u);  // nothing moved: the buffer is the input's
+  const Vertices X = m.file->rest.array() + 1.0;
+  write_mesh_file(dir / "moved.gltf", *m.file, X);
+  const Json json = Json::parse(std::ifstream(dir / "moved.gltf"));
+  EXPECT_EQ(json["buffers"][0]["uri"], "moved.bin");
+  EXPECT_LT((read_mesh(dir / "moved.gltf", {.keep_file = true, .companions = {}}).file->rest - X)
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-5);
+  // Into another folder: under its own name there.
+  std::filesystem::create_directories(dir / "out");
+  write_mesh_file(dir / "out" / "moved.gltf", *m.file, X);
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "scene data.bin"));
+  EXPECT_EQ(Json::parse(std::ifstream(dir / "out" / "moved.gltf"))["buffers"][0]["uri"],
+            "scene data.bin");
+  // Without it: one clear error.
+  std::filesystem::remove(dir / "scene data.bin");
+  try {
+    read_mesh(dir / "scene.gltf");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene data.bin"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+void expect_refused(const tinygltf::Model& model, const std::string& fragment) {
+  std::ostringstream out;
+  tinygltf::TinyGLTF writer;
+  ASSERT_TRUE(writer.WriteGltfSceneToStream(&model, out, false, true));
+  try {
+    read_mesh_from_memory(out.str(), MeshFormat::Glb, "t.glb");
+    ADD_FAILURE() << "no error, expected '" << fragment << "'";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+  }
+}
+
+TEST(Gltf, WhatCannotBeRewrittenIsRefused) {
+  {
+    TestScene s;
+    s.model.extensionsRequired = {"KHR_draco_mesh_compression"};
+    expect_refused(s.model, "KHR_draco_mesh_compression");
+  }
+  {
+    TestScene s;
+    s.model.accessors[0].sparse.isSparse = true;
+    s.model.accessors[0].sparse.count = 1;
+    expect_refused(s.model, "sparse");
+  }
+  {
+    TestScene s;  // quantised: the triangle's positions as shorts
+    const int view = s.view(std::vector<int16_t>{0, 0, 0, 1, 0, 0, 0, 1, 0, 0});
+    s.model.meshes[1].primitives[0].attributes["POSITION"] =
+        s.accessor(view, 0, 3, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_SHORT);
+    expect_refused(s.model, "quantised");
+  }
+  {
+    TestScene s;
+    s.model.nodes[2].mesh = 0;  // the cube drawn twice
+    expect_refused(s.model, "drawn by two nodes");
+  }
+  {
+    TestScene s;
+    s.model.accessors[5].count = 1000;  // beyond its buffer
+    expect_refused(s.model, "beyond its buffer");
+  }
+  for (const std::string& bad : {std::string("glTF"), std::string("glTF\x02\0\0\0\xff\xff\0\0", 12),
+                                 std::string("{\"asset\": {\"version\": \"2.0\"}}")}) {
+    EXPECT_THROW(read_mesh_from_memory(bad, MeshFormat::Glb, "t.glb"), InputError);
+    EXPECT_THROW(read_mesh_from_memory(bad, MeshFormat::Gltf, "t.gltf"), InputError);
+  }
+}
+
+}  // namespace
+}  // namespace specdeform
