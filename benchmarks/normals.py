@@ -1,134 +1,139 @@
-"""How the file's normals follow a deformation: follow, recompute and rotate (mesh_file.h) on a
-hard-edged machined part and on a smooth character, both as Blender exports them
-(tests/files/export_assets.py), bent by the same scene as the file tests (tests/python/test_files.py).
+"""How the file's normals follow a deformation: follow, recompute and rotate (mesh_file.h),
+against the exact answer, on a hard-edged machined part and on a smooth character as Blender
+exports them (tests/files/export_assets.py).
 
-For each corner of a face that names a normal, the shading angle is the angle between the normal
-and the face's own normal. Written back after the bend, a normal that looks right keeps each
-corner's shading angle (a flat side stays flat: 0 before and after; a smooth vertex's normal stays
-as far from each face around it as it was). Reported per mode: the mean and the largest change of
-the corners' shading angles (degrees), the same over the corners of hard edges only (a normal a
-side has alone), and the change of the file's normals with nothing moved.
+The deformation is an analytic bend phi (the long axis curled through 90 degrees), so the
+exact normal of every corner is known: a smooth surface's normal n is carried to
+J^-T n / |J^-T n|, J the Jacobian of phi at the corner's vertex (central differences). Each mode
+writes the bent positions phi(V) with its normals (MeshFile.write); reported per mode: the mean
+and largest angle (degrees) between each face corner's written normal and its exact one, over the
+corners whose normal row is theirs (used at one position), over those at hard edges (a position
+with several normals), and over rows shared by several positions (a deduplicating exporter's:
+one row cannot follow corners turned apart; beside it the best a single row can do), and the
+largest change of a normal when nothing moved.
 
     PYTHONPATH=build/python /usr/bin/python3 benchmarks/normals.py ASSETS_DIR [--markdown FILE]
 
-ASSETS_DIR: where tests/files/export_assets.py wrote cad_part.obj and spot.obj.
+ASSETS_DIR: where tests/files/export_assets.py wrote cad_part.obj/.glb and spot.obj/.glb.
 """
 
 import argparse
 import json
 import pathlib
-import subprocess
-import sys
 import tempfile
 
 import numpy as np
 
 import specdeform
 
-HERE = pathlib.Path(__file__).resolve().parent
+
+def unit(a):
+    return a / np.linalg.norm(a, axis=-1, keepdims=True)
 
 
-def obj_faces(text):
-    """Each face's corners as (v, vn) pairs, 0-based (vn -1: none)."""
-    faces, v_count, vn_count = [], 0, 0
-    for line in text.split("\n"):
-        if line.startswith("v "):
-            v_count += 1
-        elif line.startswith("vn "):
-            vn_count += 1
-        elif line.startswith("f "):
-            corners = []
-            for c in line.split()[1:]:
-                parts = c.split("/")
-                v = int(parts[0])
-                n = int(parts[2]) if len(parts) > 2 and parts[2] else 0
-                corners.append((v - 1 if v > 0 else v_count + v,
-                                n - 1 if n > 0 else (vn_count + n if n < 0 else -1)))
-            faces.append(corners)
-    return faces
+def bend(V):
+    """phi: the longest axis curled through 90 degrees about a line beside the shape."""
+    lo, hi = V.min(0), V.max(0)
+    a = int(np.argmax(hi - lo))
+    b = (a + 1) % 3
+    length = hi[a] - lo[a]
+    radius = length / (np.pi / 2)
+
+    def phi(X):
+        t = (X[:, a] - lo[a]) / radius
+        r = radius - (X[:, b] - lo[b])
+        Y = X.copy()
+        Y[:, a] = lo[a] + r * np.sin(t)
+        Y[:, b] = lo[b] + radius - r * np.cos(t)
+        return Y
+    return phi
 
 
-def numbers(text, key):
-    return np.array([[float(x) for x in line.split()[1:4]] for line in text.split("\n")
-                     if line.startswith(key + " ")])
+def exact_normals(phi, P, N, h):
+    """J^-T n at each point, J by central differences."""
+    J = np.empty((len(P), 3, 3))
+    for k in range(3):
+        e = np.zeros(3)
+        e[k] = h
+        J[:, :, k] = (phi(P + e) - phi(P - e)) / (2 * h)
+    return unit(np.linalg.solve(np.transpose(J, (0, 2, 1)), N[..., None])[..., 0])
 
 
-def shading_angles(positions, normals, faces):
-    """Per corner with a normal: the angle (degrees) between it and its face's normal (Newell)."""
-    out = []
-    for corners in faces:
-        p = positions[[v for v, _ in corners]]
-        n = np.cross(p - p.mean(0), np.roll(p, -1, 0) - p.mean(0)).sum(0)
-        n /= np.linalg.norm(n)
-        for _, k in corners:
-            if k >= 0:
-                out.append(np.degrees(np.arccos(np.clip(normals[k] @ n, -1, 1))))
-    return np.array(out)
+def corner_kinds(file, N0):
+    """Per corner: at a hard edge (its position has normals more than a degree apart), and on a
+    shared normal (one row used at several positions: exporters merge equal normals, Blender's
+    OBJ writer on flat and cylindrical parts; one row cannot follow corners turned apart)."""
+    position = file.info.file_to_vertex[file.corners]
+    rows = file.corner_normal
+    normals_at, positions_of = {}, {}
+    for p, n in zip(position, rows):
+        normals_at.setdefault(p, set()).add(n)
+        positions_of.setdefault(n, set()).add(p)
+    crease = {p: min((float(N0[a] @ N0[b]) for a in ns for b in ns), default=1.0)
+              for p, ns in normals_at.items()}
+    hard = np.array([crease[p] < np.cos(np.radians(1)) for p in position])
+    shared = np.array([len(positions_of[n]) > 1 for n in rows])
+    return hard, shared
 
 
-def hard_corners(faces, normal_count):
-    """Corners whose normal is shared by several positions: the flat sides of hard edges (a
-    cap); a smooth vertex has a normal of its own."""
-    users = [[] for _ in range(normal_count)]
-    for corners in faces:
-        for v, k in corners:
-            if k >= 0:
-                users[k].append(v)
-    mask = []
-    for corners in faces:
-        for v, k in corners:
-            if k >= 0:
-                mask.append(len(set(users[k])) > 1)  # shared by several positions: a flat side
-    return np.array(mask)
+def angles(a, b):
+    return np.degrees(np.arccos(np.clip(np.sum(unit(a) * unit(b), 1), -1, 1)))
 
 
-def measure(path: pathlib.Path, cli: str, work: pathlib.Path):
-    text = path.read_text()
-    faces = obj_faces(text)
-    rest = numbers(text, "v")
-    normals0 = numbers(text, "vn")
-    before = shading_angles(rest, normals0, faces)
-    hard = hard_corners(faces, len(normals0))
-    sys.path.insert(0, str(HERE.parent / "tests" / "python"))
-    from test_files import scene_for  # the file tests' bend
+def stats(error):
+    return None if error.size == 0 else [float(error.mean()), float(error.max())]
 
+
+def measure(path: pathlib.Path, work: pathlib.Path):
     V, F, file = specdeform.read_mesh(path, keep=True)
-    scene = scene_for(V, F, file.info, work)
-    rows = []
+    phi = bend(V)
+    rest = file.info.file_vertices
+    diagonal = np.linalg.norm(rest.max(0) - rest.min(0))
+    with_normal = file.corner_normal >= 0
+    corners = file.corners[with_normal]
+    rows = file.corner_normal[with_normal]
+    N0 = unit(np.array(file.normals))
+    truth = exact_normals(phi, rest[corners], N0[rows], 1e-5 * diagonal)
+    hard, shared = (k[with_normal] for k in corner_kinds(file, N0))
+    # The best one row can do: the mean of its corners' exact normals.
+    best = np.zeros_like(N0)
+    np.add.at(best, rows, truth)
+    floor = angles(best[rows], truth)
+    out_rows = []
     for mode in ("follow", "recompute", "rotate"):
-        out = work / f"{path.stem}-{mode}.obj"
-        subprocess.run([cli, "deform", str(path), "--scene", str(scene), "-o", str(out),
-                        "--normals", mode], check=True, capture_output=True)
-        moved = out.read_text()
-        after = shading_angles(numbers(moved, "v"), numbers(moved, "vn"), faces)
-        change = np.abs(after - before)
-        same = work / f"{path.stem}-{mode}-same.obj"
+        out = work / f"{path.stem}-{mode}{path.suffix}"
+        file.write(out, phi(V), normals=mode)
+        written = np.array(specdeform.read_mesh(out, keep=True)[2].normals)[rows]
+        error = angles(written, truth)
+        same = work / f"{path.stem}-{mode}-same{path.suffix}"
         file.write(same, V, normals=mode)
-        identity = numbers(same.read_text(), "vn")
-        drift = np.degrees(np.arccos(np.clip(np.sum(identity * normals0, 1), -1, 1)))
-        rows.append({"file": path.name, "mode": mode,
-                     "mean_change_deg": float(change.mean()), "max_change_deg": float(change.max()),
-                     "flat_sides_max_deg": float(change[hard].max()) if hard.any() else None,
-                     "nothing_moved_max_deg": float(drift.max())})
-    return rows
+        drift = angles(np.array(specdeform.read_mesh(same, keep=True)[2].normals), N0)
+        out_rows.append({"file": path.name, "mode": mode, "corners": int(len(rows)),
+                         "own": stats(error[~shared]), "hard": stats(error[hard & ~shared]),
+                         "shared": stats(error[shared]), "shared_floor": stats(floor[shared]),
+                         "p95": float(np.percentile(error[~shared], 95)) if (~shared).any() else None,
+                         "nothing_moved_max": float(drift.max())})
+    return out_rows
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("assets")
-    parser.add_argument("--cli", default=str(HERE.parent / "build" / "bin" / "specdeform"))
     parser.add_argument("--markdown")
     args = parser.parse_args()
     rows = []
     with tempfile.TemporaryDirectory() as work:
-        for name in ("cad_part.obj", "spot.obj"):
-            rows += measure(pathlib.Path(args.assets) / name, args.cli, pathlib.Path(work))
-    table = ("| file | normals | mean change of the shading angle | largest | largest on flat "
-             "sides | nothing moved: largest change |\n|---|---|---|---|---|---|\n")
+        for name in ("cad_part.obj", "cad_part.glb", "spot.obj", "spot.glb"):
+            rows += measure(pathlib.Path(args.assets) / name, pathlib.Path(work))
+    fmt = lambda s: "-" if s is None else f"{s[0]:.3f}° / {s[1]:.2f}°"
+    table = ("| file | normals | corners of their own normal: mean / largest error | 95% | at hard "
+             "edges | on shared normals (the best one row can do) | nothing moved: largest "
+             "change |\n|---|---|---|---|---|---|---|\n")
     for r in rows:
-        flat = "-" if r["flat_sides_max_deg"] is None else f"{r['flat_sides_max_deg']:.3f}°"
-        table += (f"| {r['file']} | {r['mode']} | {r['mean_change_deg']:.3f}° | "
-                  f"{r['max_change_deg']:.2f}° | {flat} | {r['nothing_moved_max_deg']:.3f}° |\n")
+        p95 = "-" if r["p95"] is None else f"{r['p95']:.2f}°"
+        shared = "-" if r["shared"] is None else f"{fmt(r['shared'])} ({fmt(r['shared_floor'])})"
+        table += (f"| {r['file']} | {r['mode']} | {fmt(r['own'])} | {p95} | {fmt(r['hard'])} | "
+                  f"{shared} | {r['nothing_moved_max']:.4f}° |\n")
     print(json.dumps(rows, indent=1))
     print(table)
     if args.markdown:

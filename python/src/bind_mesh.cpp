@@ -177,11 +177,29 @@ what was dropped or copied beside the output.)")
           },
           "Per polygon corner, its row of uv (-1: none).")
       .def_property_readonly(
+          "corners",
+          [](py::object self) {
+            return index_view(self.cast<const KeptFile&>().file->attributes.corners, self);
+          },
+          "The file's polygons' corners (file vertices), concatenated; see offsets.")
+      .def_property_readonly(
+          "offsets",
+          [](py::object self) {
+            return index_view(self.cast<const KeptFile&>().file->attributes.offsets, self);
+          },
+          "Polygon p has the corners corners[offsets[p]:offsets[p + 1]].")
+      .def_property_readonly(
+          "corner_normal",
+          [](py::object self) {
+            return index_view(self.cast<const KeptFile&>().file->attributes.corner_normal, self);
+          },
+          "Per polygon corner, its row of normals (-1: none).")
+      .def_property_readonly(
           "normals",
           [](py::object self) {
             return view(self.cast<const KeptFile&>().file->attributes.normals, self);
           },
-          "The file's normals (k, 3) (empty: none).")
+          "The file's normals (k, 3), glTF's in world space (empty: none).")
       .def_property_readonly(
           "colours",
           [](py::object self) {

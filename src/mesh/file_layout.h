@@ -96,7 +96,8 @@ struct GltfLayout {
   GltfContainer container = GltfContainer::Glb;
   std::string json;  // the JSON as written (a .glb's JSON chunk, unpadded)
   std::vector<GltfBuffer> buffers;
-  std::string glb_tail;  // a .glb's chunks after BIN, as they were
+  std::string glb_tail;   // a .glb's chunks after BIN, as they were
+  std::string glb_after;  // bytes after the length its header gives, as they were
   std::vector<GltfPrimitive> primitives;
   Eigen::MatrixX4d tangents;  // per file vertex, world space xyz and w (with NORMAL)
   int meshes = 0, skins = 0, animations = 0, morph_targets = 0, images = 0, uv_sets = 0;

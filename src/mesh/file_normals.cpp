@@ -96,6 +96,41 @@ std::vector<Eigen::Matrix3d> vertex_rotations(const FileAttributes& a, const Ver
 
 }  // namespace
 
+SharedNormals shared_normals(const FileAttributes& a, const Vertices& rest,
+                             const Vertices& deformed, const Eigen::MatrixX3d& normals) {
+  // The rows used at more than one position.
+  std::vector<int> position(a.normals.rows(), -1);
+  std::vector<char> shared(a.normals.rows(), 0);
+  for (size_t c = 0; c < a.corners.size(); ++c) {
+    const int row = a.corner_normal[c];
+    if (row < 0) continue;
+    const Eigen::RowVector3d p = rest.row(a.corners[c]);
+    if (position[row] < 0) {
+      position[row] = a.corners[c];
+    } else if (rest.row(position[row]) != p) {
+      shared[row] = 1;
+    }
+  }
+  std::vector<double> spread(a.normals.rows(), 0.0);
+  for_each_corner(a, [&](int, int corner, const Corner& c) {
+    const int row = a.corner_normal[corner];
+    if (row < 0 || !shared[row]) return;
+    Eigen::Matrix3d r, d;
+    if (!frame(rest, c, r) || !frame(deformed, c, d)) return;
+    const Vec own =
+        d.transpose().partialPivLu().solve(r.transpose() * a.normals.row(row).transpose());
+    const Vec written = normals.row(row).transpose();
+    spread[row] = std::max(spread[row], std::atan2(own.cross(written).norm(), own.dot(written)));
+  });
+  SharedNormals out;
+  for (const double s : spread) {
+    const double degrees = s * 180.0 / M_PI;
+    if (degrees > SharedNormals::kTurnedApart) ++out.turned_apart;
+    out.largest_degrees = std::max(out.largest_degrees, degrees);
+  }
+  return out;
+}
+
 Eigen::MatrixX3d updated_normals(const FileAttributes& a, const Vertices& rest,
                                  const Vertices& deformed, NormalUpdate mode) {
   const std::vector<char> moved = moved_polygons(a, rest, deformed);

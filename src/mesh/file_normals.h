@@ -20,6 +20,18 @@ namespace specdeform::detail {
 Eigen::MatrixX3d updated_normals(const FileAttributes& a, const Vertices& rest,
                                  const Vertices& deformed, NormalUpdate mode);
 
+// Normal rows used at several positions (exporters merge equal normals: Blender's OBJ writer
+// on flat and cylindrical parts): one row cannot follow corners that the deformation turns
+// apart. How many rows have a corner whose own transported normal (J^-T n) is more than
+// kTurnedApart degrees from the row's `normals` (updated), and the largest such angle.
+struct SharedNormals {
+  static constexpr double kTurnedApart = 5.0;
+  int turned_apart = 0;
+  double largest_degrees = 0.0;
+};
+SharedNormals shared_normals(const FileAttributes& a, const Vertices& rest,
+                             const Vertices& deformed, const Eigen::MatrixX3d& normals);
+
 // Tangents with rows like a.normals' (glTF: one per split vertex), carried by the gradients of
 // the corners that use them, made orthogonal to `normals` (the updated normals) and unit.
 Eigen::MatrixX3d updated_tangents(const FileAttributes& a, const Vertices& rest,

@@ -1,5 +1,6 @@
 #include "file_rewriters.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -21,36 +22,45 @@ const Layout& layout_of(const MeshFile& file) {
 std::string rewrite_obj(const MeshFile& file, const Vertices& positions,
                         const Eigen::MatrixX3d& normals) {
   const ObjLayout& layout = layout_of<ObjLayout>(file);
-  TextRewriter out(file.layout->bytes);
-  // The v and vn lines in file order.
-  size_t v = 0, vn = 0;
-  const size_t nv = layout.v.size(), nn = normals.rows() > 0 ? layout.vn.size() : 0;
-  while (v < nv || vn < nn) {
-    if (vn >= nn || (v < nv && layout.v[v] < layout.vn[vn])) {
-      out.seek(layout.v[v]);
-      for (int k = 0; k < 3; ++k) out.replace(positions(Eigen::Index(v), k), NumberText::Auto);
-      ++v;
-    } else {
-      out.seek(layout.vn[vn]);
-      for (int k = 0; k < 3; ++k) out.replace(normals(Eigen::Index(vn), k), NumberText::Float);
-      ++vn;
+  const std::vector<size_t> none;
+  const std::vector<size_t>& vn = normals.rows() > 0 ? layout.vn : none;
+  return rewrite_text(file.layout->bytes, [&](TextRewriter& out, size_t from, size_t to) {
+    // The v and vn lines in [from, to), in file order.
+    const auto first = [&](const std::vector<size_t>& lines, size_t offset) {
+      return size_t(std::lower_bound(lines.begin(), lines.end(), offset) - lines.begin());
+    };
+    size_t v = first(layout.v, from), n = first(vn, from);
+    const size_t v_end = first(layout.v, to), n_end = first(vn, to);
+    while (v < v_end || n < n_end) {
+      if (n >= n_end || (v < v_end && layout.v[v] < vn[n])) {
+        out.seek(layout.v[v]);
+        for (int k = 0; k < 3; ++k) out.replace(positions(Eigen::Index(v), k), NumberText::Auto);
+        ++v;
+      } else {
+        out.seek(vn[n]);
+        for (int k = 0; k < 3; ++k) out.replace(normals(Eigen::Index(n), k), NumberText::Float);
+        ++n;
+      }
     }
-  }
-  return out.finish();
+  });
 }
 
 std::string rewrite_off(const MeshFile& file, const Vertices& positions,
                         const Eigen::MatrixX3d& normals) {
   const OffLayout& layout = layout_of<OffLayout>(file);
-  TextRewriter out(file.layout->bytes);
-  for (size_t i = 0; i < layout.vertex.size(); ++i) {
-    out.seek(layout.vertex[i]);
-    for (int k = 0; k < 3; ++k) out.replace(positions(Eigen::Index(i), k), NumberText::Auto);
-    if (layout.normals && normals.rows() > 0) {
-      for (int k = 0; k < 3; ++k) out.replace(normals(Eigen::Index(i), k), NumberText::Float);
+  return rewrite_text(file.layout->bytes, [&](TextRewriter& out, size_t from, size_t to) {
+    const auto at = [&](size_t offset) {
+      return size_t(std::lower_bound(layout.vertex.begin(), layout.vertex.end(), offset) -
+                    layout.vertex.begin());
+    };
+    for (size_t i = at(from), end = at(to); i < end; ++i) {
+      out.seek(layout.vertex[i]);
+      for (int k = 0; k < 3; ++k) out.replace(positions(Eigen::Index(i), k), NumberText::Auto);
+      if (layout.normals && normals.rows() > 0) {
+        for (int k = 0; k < 3; ++k) out.replace(normals(Eigen::Index(i), k), NumberText::Float);
+      }
     }
-  }
-  return out.finish();
+  });
 }
 
 namespace {
@@ -210,14 +220,21 @@ std::string rewrite_stl(const MeshFile& file, const Vertices& positions,
   const StlLayout& layout = layout_of<StlLayout>(file);
   const FileAttributes& a = file.attributes;
   if (layout.ascii) {
-    TextRewriter out(file.layout->bytes);
+    // Each facet's normal and its corners, in the order they stand in the file (a "normal" may
+    // follow its loop).
+    std::vector<std::pair<size_t, Eigen::Vector3d>> numbers;
     for (int f = 0; f < a.num_polygons(); ++f) {
-      out.seek(layout.facet_normal[f]);
-      for (int k = 0; k < 3; ++k) out.replace(normals(f, k), NumberText::Float);
+      numbers.emplace_back(layout.facet_normal[f], normals.row(f).transpose());
       for (int c = a.offsets[f]; c < a.offsets[f + 1]; ++c) {
-        out.seek(layout.corner[c]);
-        for (int k = 0; k < 3; ++k) out.replace(positions(a.corners[c], k), NumberText::Float);
+        numbers.emplace_back(layout.corner[c], positions.row(a.corners[c]).transpose());
       }
+    }
+    std::sort(numbers.begin(), numbers.end(),
+              [](const auto& x, const auto& y) { return x.first < y.first; });
+    TextRewriter out(file.layout->bytes);
+    for (const auto& [offset, value] : numbers) {
+      out.seek(offset);
+      for (int k = 0; k < 3; ++k) out.replace(value[k], NumberText::Float);
     }
     return out.finish();
   }

@@ -183,6 +183,7 @@ EncodedMesh rewrite_gltf(const MeshFile& file, const Vertices& positions,
     main += bin;
   }
   main += layout.glb_tail;
+  main += layout.glb_after;
   return encoded;
 }
 

@@ -34,7 +34,7 @@ uint32_t read_u32(std::string_view data, size_t at) {
 
 // A .glb's chunks: the JSON, the BIN chunk (if any) and what follows it.
 struct GlbChunks {
-  std::string_view json, bin, tail;
+  std::string_view json, bin, tail, after;  // after: bytes beyond the header's length
   bool has_bin = false;
 };
 
@@ -46,8 +46,9 @@ GlbChunks split_glb(std::string_view data, const std::string& name) {
   if (read_u32(data, 0) != kGlbMagic) fail("no 'glTF' magic");
   if (read_u32(data, 4) != 2) fail("version " + std::to_string(read_u32(data, 4)) + ", not 2");
   if (read_u32(data, 8) > data.size()) fail("truncated: the header announces more bytes");
-  data = data.substr(0, read_u32(data, 8));
   GlbChunks out;
+  out.after = data.substr(read_u32(data, 8));
+  data = data.substr(0, read_u32(data, 8));
   size_t at = 12;
   for (int chunk = 0; at + 8 <= data.size(); ++chunk) {
     const uint32_t length = read_u32(data, at), type = read_u32(data, at + 4);
@@ -522,6 +523,7 @@ PolygonSoup parse_gltf(std::string_view data, MeshFormat format, const std::stri
     layout.buffers.push_back(std::move(buffer));
   }
   layout.glb_tail = std::string(glb.tail);
+  layout.glb_after = std::string(glb.after);
   layout.meshes = static_cast<int>(world.size());
   layout.skins = static_cast<int>(m.skins.size());
   layout.animations = static_cast<int>(m.animations.size());

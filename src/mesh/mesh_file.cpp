@@ -3,6 +3,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <set>
 
@@ -295,6 +296,18 @@ EncodedMesh encode_mesh_file(const MeshFile& file, const Vertices& positions,
                            : Eigen::MatrixX3d();
   if (format != file.format) return detail::encode_converted(file, positions, normals, out_name);
   EncodedMesh out;
+  if (normals.rows() > 0) {
+    const detail::SharedNormals shared = detail::shared_normals(a, file.rest, positions, normals);
+    if (shared.turned_apart > 0) {
+      out.notes.push_back(
+          std::to_string(shared.turned_apart) +
+          " normals are each shared by corners at several positions (the exporter merged equal "
+          "normals) that the deformation turns apart, by up to " +
+          std::to_string(static_cast<int>(std::lround(shared.largest_degrees))) +
+          " degrees: each is written as their mean, so shading there is approximate (the file's "
+          "normal indexing is kept; glTF, or an OBJ exported without merged normals, avoids it)");
+    }
+  }
   switch (format) {
     case MeshFormat::Obj:
       out.files.push_back(
@@ -319,7 +332,10 @@ EncodedMesh encode_mesh_file(const MeshFile& file, const Vertices& positions,
       const bool same_folder = std::filesystem::equivalent(
           input.parent_path().empty() ? "." : input.parent_path(),
           out_name.parent_path().empty() ? "." : out_name.parent_path(), ec);
-      return detail::rewrite_gltf(file, positions, normals, out_name, same_folder || ec);
+      EncodedMesh gltf =
+          detail::rewrite_gltf(file, positions, normals, out_name, same_folder || ec);
+      gltf.notes.insert(gltf.notes.begin(), out.notes.begin(), out.notes.end());
+      return gltf;
     }
   }
   return out;

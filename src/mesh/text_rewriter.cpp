@@ -1,14 +1,17 @@
 #include "text_rewriter.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+
+#include "linalg/parallel.h"
 
 namespace specdeform::detail {
 
 namespace {
 
-bool is_blank(char c) {
-  return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f';
+bool is_blank(char c) {  // as the text readers' (TextScanner)
+  return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
 }
 
 int significant_digits(std::string_view t) {
@@ -32,8 +35,9 @@ double read_number(std::string_view token) {
   return v;
 }
 
-TextRewriter::TextRewriter(std::string_view source) : source_(source) {
-  out_.reserve(source.size() + source.size() / 4);
+TextRewriter::TextRewriter(std::string_view source, size_t begin) : source_(source), pos_(begin) {
+  const size_t size = source.size() - begin;
+  out_.reserve(size + size / 4);
 }
 
 void TextRewriter::seek(size_t offset) {
@@ -98,9 +102,42 @@ void TextRewriter::replace(double value, NumberText style) {
   pos_ = end;
 }
 
-std::string TextRewriter::finish() {
-  seek(source_.size());
+std::string TextRewriter::finish(size_t end) {
+  seek(std::min(end, source_.size()));
   return std::move(out_);
+}
+
+std::string rewrite_text(std::string_view source,
+                         const std::function<void(TextRewriter&, size_t, size_t)>& part) {
+  constexpr size_t kSplitFrom = 8 << 20;  // bytes
+  const size_t split =
+      source.size() < kSplitFrom ? std::string_view::npos : source.find('\n', source.size() / 2);
+  if (split == std::string_view::npos) {
+    TextRewriter out(source);
+    part(out, 0, source.size());
+    return out.finish();
+  }
+  std::string first, second;
+  bool crossed = false;  // a number of the first half stood after the split (a line continued)
+  run_pair(
+      [&] {
+        TextRewriter out(source);
+        part(out, 0, split + 1);
+        crossed = out.position() > split + 1;
+        first = out.finish(split + 1);
+      },
+      [&] {
+        TextRewriter out(source, split + 1);
+        part(out, split + 1, source.size());
+        second = out.finish();
+      });
+  if (crossed) {
+    TextRewriter out(source);
+    part(out, 0, source.size());
+    return out.finish();
+  }
+  first += second;
+  return first;
 }
 
 }  // namespace specdeform::detail

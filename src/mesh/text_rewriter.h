@@ -2,6 +2,7 @@
 // the text formats). Tokens are separated by blanks and line ends; '#' ends a token.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -19,7 +20,8 @@ double read_number(std::string_view token);
 
 class TextRewriter {
  public:
-  explicit TextRewriter(std::string_view source);
+  // Rewrites source from `begin` on (the text before it is not copied).
+  explicit TextRewriter(std::string_view source, size_t begin = 0);
 
   // Copies the source up to `offset` (not before the current position).
   void seek(size_t offset);
@@ -30,8 +32,9 @@ class TextRewriter {
   // Copies the blanks, then writes `value` in place of the next token, or the token itself where
   // it reads back as `value` written in `style`.
   void replace(double value, NumberText style);
-  // The rest of the source appended; the text.
-  std::string finish();
+  size_t position() const { return pos_; }
+  // The source up to `end` appended; the text.
+  std::string finish(size_t end = std::string_view::npos);
 
  private:
   size_t token_start(size_t from) const;
@@ -41,5 +44,10 @@ class TextRewriter {
   size_t pos_ = 0;
   std::string out_;
 };
+
+// The source with its numbers rewritten by `part(out, from, to)`, which seeks and replaces those
+// at offsets in [from, to): a large text in two halves at once, split at a line.
+std::string rewrite_text(std::string_view source,
+                         const std::function<void(TextRewriter&, size_t, size_t)>& part);
 
 }  // namespace specdeform::detail

@@ -314,6 +314,26 @@ TEST(MeshFile, StlKeepsNameAndAttributes) {
     EXPECT_EQ(moved_binary.substr(84 + 50 * f + 48, 2), binary.substr(84 + 50 * f + 48, 2));
 }
 
+// What the fuzzer found: files whose identity write must still be the file. A vertical tab
+// between numbers; an STL facet whose "normal" follows its loop; bytes after a .glb's length.
+TEST(MeshFile, AwkwardLayoutsComeBackWhole) {
+  const std::string obj = "v 0 0 0\nv \v1 0 0\nv 0 1 0\nf 1 2 3\n";
+  const LoadedMesh a = keep(obj, MeshFormat::Obj);
+  EXPECT_EQ(write(a, a.file->rest, "a.obj"), obj);
+  const std::string stl =
+      "solid s\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n vertex 0 1 0\n endloop\n"
+      " facet normal 0 0 1\n endfacet\nendsolid s\n";
+  const LoadedMesh b = keep(stl, MeshFormat::Stl);
+  EXPECT_EQ(write(b, b.file->rest, "b.stl"), stl);
+  const std::string moved = write(b, b.file->rest.array() + 1.0, "b.stl");
+  EXPECT_NE(moved.find("vertex 1 1 1"), std::string::npos) << moved;
+  EXPECT_NE(moved.find("facet normal 0 0 1"), std::string::npos) << moved;
+  std::string glb = encode_mesh(make_icosphere(0), MeshFormat::Glb);
+  glb += "trailing";
+  const LoadedMesh c = keep(glb, MeshFormat::Glb);
+  EXPECT_EQ(write(c, c.file->rest, "c.glb"), glb);
+}
+
 // Another format carries what it can and names the rest.
 TEST(MeshFile, OtherFormatsCarryWhatTheyCan) {
   const LoadedMesh m = keep(kCubeObj, MeshFormat::Obj);

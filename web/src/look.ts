@@ -88,7 +88,6 @@ export class FileLook {
       (n.array as Float32Array).set(normals);
       n.needsUpdate = true;
     }
-    this.geometry.computeBoundingSphere();
   }
 
   // The selection's colours (3 per mesh vertex): `free` where the file's own colour shows.
