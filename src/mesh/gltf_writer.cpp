@@ -63,7 +63,12 @@ EncodedMesh rewrite_gltf(const MeshFile& file, const Vertices& positions,
   std::vector<std::string> buffers;
   for (const GltfBuffer& b : layout.buffers) buffers.push_back(b.bytes);
   std::vector<char> changed(buffers.size(), 0);
-  Json json = Json::parse(layout.json);
+  // tinygltf read it; NUL padding (some writers pad a .glb's JSON chunk so) is not JSON.
+  Json json =
+      Json::parse(std::string_view(layout.json)
+                      .substr(0, layout.json.find_last_not_of(std::string_view("\0 ", 2)) + 1),
+                  nullptr, false);
+  if (json.is_discarded()) throw InputError(file.name + ": its JSON cannot be rewritten");
   const Json original = json;
   const Eigen::MatrixX3d tangents = layout.tangents.rows() > 0 && normals.rows() > 0
                                         ? updated_tangents(file.attributes, file.rest, positions,

@@ -441,11 +441,9 @@ PolygonSoup parse_gltf(std::string_view data, MeshFormat format, const std::stri
       }
       const int colour_accessor = attribute("COLOR_0");
       if (colour_accessor >= 0) {
-        const int components =
-            m.accessors[std::min<size_t>(colour_accessor, m.accessors.size() - 1)].type ==
-                    TINYGLTF_TYPE_VEC3
-                ? 3
-                : 4;
+        const bool rgb = colour_accessor < int(m.accessors.size()) &&
+                         m.accessors[colour_accessor].type == TINYGLTF_TYPE_VEC3;
+        const int components = rgb ? 3 : 4;
         const auto c = r.elements(colour_accessor, components, what + " COLOR_0");
         if (c->count != vertices) r.fail(what + " COLOR_0 has another count than POSITION");
         for (int i = 0; i < vertices; ++i)

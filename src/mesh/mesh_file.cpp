@@ -211,23 +211,26 @@ std::optional<std::pair<std::string, std::string>> MeshFile::texture(int materia
   const Material& m = attributes.materials[material];
   const auto* gltf = std::get_if<detail::GltfLayout>(&layout->format);
   if (gltf && m.gltf_image >= 0) {
-    const nlohmann::json json = nlohmann::json::parse(gltf->json, nullptr, false);
-    const nlohmann::json& image = json["images"][m.gltf_image];
-    const std::string mime = image.value("mimeType", "");
-    if (image.contains("bufferView")) {
-      const nlohmann::json& view = json["bufferViews"][image["bufferView"].get<int>()];
-      const size_t buffer = view.value("buffer", 0), offset = view.value("byteOffset", 0),
-                   length = view.value("byteLength", 0);
-      if (buffer >= gltf->buffers.size()) return std::nullopt;
-      const std::string& bytes = gltf->buffers[buffer].bytes;
-      if (offset > bytes.size() || length > bytes.size() - offset) return std::nullopt;
-      return std::pair{bytes.substr(offset, length), mime};
+    try {
+      const nlohmann::json json = nlohmann::json::parse(gltf->json);
+      const nlohmann::json& image = json.at("images").at(m.gltf_image);
+      if (image.contains("bufferView")) {
+        const nlohmann::json& view = json.at("bufferViews").at(image.at("bufferView").get<int>());
+        const size_t buffer = view.value("buffer", 0), offset = view.value("byteOffset", 0),
+                     length = view.value("byteLength", 0);
+        if (buffer >= gltf->buffers.size()) return std::nullopt;
+        const std::string& bytes = gltf->buffers[buffer].bytes;
+        if (offset > bytes.size() || length > bytes.size() - offset) return std::nullopt;
+        return std::pair{bytes.substr(offset, length), image.value("mimeType", "")};
+      }
+    } catch (const nlohmann::json::exception&) {
+      return std::nullopt;
     }
     if (tinygltf::IsDataURI(m.texture)) {
       std::vector<unsigned char> data;
       std::string type;
       if (!tinygltf::DecodeDataURI(&data, type, m.texture, 0, false)) return std::nullopt;
-      return std::pair{std::string(data.begin(), data.end()), mime.empty() ? type : mime};
+      return std::pair{std::string(data.begin(), data.end()), type};
     }
   }
   if (m.texture.empty() || !companions) return std::nullopt;

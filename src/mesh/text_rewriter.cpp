@@ -48,7 +48,15 @@ void TextRewriter::seek(size_t offset) {
 
 size_t TextRewriter::token_start(size_t from) const {
   size_t p = from;
-  while (p < source_.size() && is_blank(source_[p])) ++p;
+  while (p < source_.size()) {
+    if (is_blank(source_[p])) {
+      ++p;
+    } else if (source_[p] == '#') {  // a comment, to the line's end, as the readers skip it
+      while (p < source_.size() && source_[p] != '\n') ++p;
+    } else {
+      break;
+    }
+  }
   return p;
 }
 

@@ -1,5 +1,6 @@
 // Internal: a text file copied with some of its numbers replaced (the same-format writers of
-// the text formats). Tokens are separated by blanks and line ends; '#' ends a token.
+// the text formats). Tokens are separated by blanks, line ends and '#' comments (to the line's
+// end), as the text readers (TextScanner) read them.
 #pragma once
 
 #include <functional>

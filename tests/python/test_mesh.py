@@ -36,6 +36,39 @@ def test_read_mesh_maps_back_to_the_file(tmp_path):
     np.testing.assert_array_equal(info2.file_vertices[1], [9, 9, 9])
 
 
+def test_kept_file_comes_back_with_new_positions(tmp_path):
+    # A quad with texture coordinates, a normal, a material and a comment: written back with
+    # V moved, every other line as it was; its polygons and attributes readable.
+    text = ("# quad\nmtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 1\n"
+            "vn 0 0 1\nusemtl red\nf 1/1/1 2/2/1 3/2/1 4/1/1\n")
+    path = tmp_path / "quad.obj"
+    path.write_text(text)
+    V, F, file = specdeform.read_mesh(path, keep=True)
+    assert F.shape == (2, 3) and file.format == "OBJ"
+    np.testing.assert_array_equal(file.offsets, [0, 4])
+    np.testing.assert_array_equal(file.corner_uv, [0, 1, 1, 0])
+    assert file.summary()["polygons_by_corners"] == {4: 1}
+    assert file.summary()["materials"] == ["red"]
+    out = tmp_path / "out.obj"
+    assert file.write(out, V) == []
+    assert out.read_text() == text
+    turn = np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 1]])  # a quarter turn about z
+    file.write(out, V @ turn.T, normals="recompute")
+    lines = out.read_text().split("\n")
+    assert [l for l in lines if not l.startswith("v ")] == [
+        l for l in text.split("\n") if not l.startswith("v ")]
+    V2, F2, back = specdeform.read_mesh(out, keep=True)
+    np.testing.assert_allclose(V2, V @ turn.T, atol=1e-7)
+    np.testing.assert_allclose(back.normals, [[0, 0, 1]])
+    # Another format: what it cannot hold is said.
+    notes = file.write(tmp_path / "out.stl", V)
+    assert "texture coordinates" in notes[0] and "materials" in notes[0]
+    with pytest.raises(specdeform.InputError, match="rows"):
+        file.write(out, V[:3])
+    with pytest.raises(specdeform.InputError, match="normals"):
+        file.write(out, V, normals="sideways")
+
+
 def test_shared_mesh_reads(tmp_path):
     V, F = specdeform.read_mesh(shared_file("models/cow.off"))
     assert V.shape == (2762, 3) and F.shape == (5520, 3)
