@@ -5,6 +5,7 @@ Writes to OUT:
   spot.glb           UV-mapped, a base colour image, smooth normals, split along UV seams
   spot.obj/.mtl      the same as OBJ + MTL (+ spot_texture.png)
   spot_colors.ply    binary PLY with normals, texture coordinates and a colour per vertex
+  spot_colors.glb    the same colours as glTF's COLOR_0
   beast.glb          the polygon (quad) model, triangulated by the exporter, with its UVs
   beast.obj          quads and n-gons with their texture coordinates and normals
   cad_part.obj/.glb  a machined part: a cylinder whose 48-gon caps meet its smooth side at
@@ -68,11 +69,15 @@ spot.data.materials.clear()
 spot.data.materials.append(textured_material("Spot", os.path.join(out, "spot_texture.png")))
 bpy.ops.object.shade_smooth()
 export(spot, "spot")
-colors = spot.data.color_attributes.new("Col", "BYTE_COLOR", "POINT")
-for i, c in enumerate(colors.data):
+# Blender 3.4's PLY writer takes the (legacy) face-corner colour layer.
+colors = spot.data.vertex_colors.new(name="Col")
+for loop, c in zip(spot.data.loops, colors.data):
+    i = loop.vertex_index
     c.color = (0.5 + 0.5 * math.sin(i), 0.5 + 0.5 * math.cos(i), 0.25, 1.0)
 bpy.ops.export_mesh.ply(filepath=os.path.join(out, "spot_colors.ply"), use_selection=True,
                         use_normals=True, use_uv_coords=True, use_colors=True)
+bpy.ops.export_scene.gltf(filepath=os.path.join(out, "spot_colors.glb"), export_format="GLB",
+                          use_selection=True, export_colors=True)
 
 beast = imported(os.path.join(models, "beast.obj"))
 bpy.ops.object.shade_smooth()

@@ -17,8 +17,8 @@ import pytest
 import specdeform
 from conftest import ROOT, SHARED
 
-BLENDER_FILES = ["spot.obj", "spot.glb", "spot_colors.ply", "beast.obj", "beast.glb",
-                 "cad_part.obj", "cad_part.glb"]
+BLENDER_FILES = ["spot.obj", "spot.glb", "spot_colors.ply", "spot_colors.glb", "beast.obj",
+                 "beast.glb", "cad_part.obj", "cad_part.glb"]
 SHARED_FILES = ["gltf/polycam-scan.glb", "gltf/blender-monkey-display.glb",
                 "awkward/quadknot.obj", "awkward/fuze.ply", "awkward/fuze_ascii.ply",
                 "awkward/teapot.stl", "models/cow.off"]
@@ -171,7 +171,7 @@ def rewritten_bytes(gltf):
     return mask
 
 
-@pytest.mark.parametrize("name", ["spot.glb", "beast.glb", "cad_part.glb",
+@pytest.mark.parametrize("name", ["spot.glb", "spot_colors.glb", "beast.glb", "cad_part.glb",
                                   "gltf/polycam-scan.glb", "gltf/blender-monkey-display.glb"])
 def test_deformed_gltf_rewrites_positions_normals_tangents_only(name, request, cli, tmp_path):
     path = source(name, request)
