@@ -95,7 +95,7 @@ void add_compare_command(CLI::App& app) {
     options.validate();
     const std::vector<Eigen::Affine3d>& transforms = loaded.scene.transforms;
     const ConstrainedSet set = constrained_set(loaded.selection, mesh, options.unconstrained,
-                                               loaded.mesh.info.vertex_to_file);
+                                               loaded.mesh.info.vertex_to_file, loaded.name);
     ManifoldHarmonicsOptions h = args->harmonics;
     h.num_modes =
         loaded.scene.modes && cmd->count("--modes") == 0 ? *loaded.scene.modes : args->modes;
@@ -119,12 +119,7 @@ void add_compare_command(CLI::App& app) {
       methods.push_back(std::move(m));
       // How far the smooth base is from its own targets (those of the details are met exactly
       // by the transfer's anchors).
-      const Eigen::MatrixX3d targets = constraint_targets(set, deformer.base(), transforms);
-      double miss = 0.0;
-      for (size_t i = 0; i < set.vertices.size(); ++i)
-        miss =
-            std::max(miss, (deformer.deformed_base().row(set.vertices[i]) - targets.row(i)).norm());
-      return miss / diagonal;
+      return deformer.base_miss().max;
     };
     DeformOptions o = options;
     o.energy = DeformEnergy::Linear;

@@ -59,7 +59,7 @@ void add_converge_command(CLI::App& app) {
     DeformOptions options = args->deform.merged(*cmd, s.scene.options);
     options.validate();
     // Every check of the selection before the basis, which may take long.
-    constrained_set(s.selection, mesh, options.unconstrained, s.mesh.info.vertex_to_file);
+    constrained_set(s.selection, mesh, options.unconstrained, s.mesh.info.vertex_to_file, s.name);
     std::vector<int> modes = args->modes;
     std::sort(modes.begin(), modes.end());
     modes.erase(std::unique(modes.begin(), modes.end()), modes.end());

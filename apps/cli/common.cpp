@@ -251,7 +251,7 @@ LoadedScene load_scene(const std::string& mesh_path, const SceneArgs& args,
     path = scene_mesh(args.scene).string();
     if (path.empty()) throw InputError(args.scene + ": the scene names no mesh; give MESH");
   }
-  LoadedScene out{load_mesh(path), {}, {}};
+  LoadedScene out{load_mesh(path), {}, {}, {}};
   const MeshReadInfo& info = out.mesh.info;
   const int file_vertices = static_cast<int>(info.file_vertices.rows());
   if (!args.scene.empty()) {
@@ -266,6 +266,7 @@ LoadedScene load_scene(const std::string& mesh_path, const SceneArgs& args,
   const std::string& name = !args.scene.empty() ? args.scene
                             : !args.sel.empty() ? args.sel
                                                 : args.dmat;
+  out.name = name;
   std::vector<std::string> notes;
   if (args.influence > 0.0) out.scene.influence = args.influence;
   out.selection = scene_selection(out.scene, out.mesh, &notes, name);

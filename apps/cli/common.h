@@ -85,6 +85,7 @@ struct LoadedScene {
   LoadedMesh mesh;
   Scene scene;
   Selection selection;
+  std::string name;  // the file the selection came from (the scene, .sel or .dmat)
 };
 LoadedScene load_scene(const std::string& mesh_path, const SceneArgs& args,
                        const DeformOptions& defaults);

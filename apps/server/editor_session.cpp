@@ -786,7 +786,7 @@ void EditorSession::solve_and_send(bool preview) {
     s.shown_displacements = deformer.applied_detail() != s.options.detail;
   }
   const FrameTimings& t = deformer.frame_timings();
-  const ConstraintError e = deformer.constraint_error(view.preview ? shown : s.result);
+  const ConstraintError& e = deformer.base_miss();
   const ArapReport& arap = deformer.arap_report();
   const FrameStats stats{t.reduced_solve,
                          t.inverse_transform,

@@ -23,7 +23,8 @@
 //   102 frame      u32 tag | u32 seq | u32 n | u32 view (bit 0: smooth base, bit 1: preview,
 //                  bit 2: the smooth base folded, details added as displacements there) |
 //                  f32 reduced solve, inverse transform, detail, total (ms) |
-//                  f32 constraint error max, rms (over the bounding-box diagonal) |
+//                  f32 the smooth base's miss of its targets, max, rms (over the bounding-box
+//                  diagonal: SpectralDeformer::base_miss) |
 //                  u32 ARAP iterations | u32 1 if ARAP converged (or the energy is linear) |
 //                  f32 scale | i16 displacements (3 n, then zeros to a multiple of 4 bytes):
 //                  position = rest position + scale * displacement, of all vertices or of the

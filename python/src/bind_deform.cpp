@@ -30,7 +30,13 @@ Selection to_selection(py::handle handles, py::handle fixed, Eigen::Index n) {
   }
   Selection s;
   for (py::handle group : handles) {
-    s.handles.push_back(to_indices(group, n, "handles[" + std::to_string(s.handles.size()) + "]"));
+    const std::string name = "handles[" + std::to_string(s.handles.size()) + "]";
+    s.handles.push_back(to_indices(group, n, name));
+    // An empty group would take a transform and move nothing: the solve would return the input.
+    if (s.handles.back().empty()) throw InputError(name + ": an empty handle group (no vertex)");
+  }
+  if (s.handles.empty()) {
+    throw InputError("handles: no handle group (give one vertex index array per group)");
   }
   s.fixed = to_indices(fixed, n, "fixed");
   return s;
@@ -143,8 +149,9 @@ iterations, clusters, arap_tolerance, arap_bending, history, warm_start).)")
             d.deformer->set_selection(s);
           },
           py::arg("handles"), py::arg("fixed") = py::tuple(),
-          R"(handles: one vertex index array (or boolean mask) per handle group; fixed: the
-vertices held in place. A vertex may belong to one group only.)")
+          R"(handles: one vertex index array (or boolean mask) per handle group, at least one, none
+empty (InputError otherwise); fixed: the vertices held in place. A vertex may belong to one group
+only.)")
       .def(
           "solve",
           [](Deformer& d, py::handle transforms) {
@@ -160,6 +167,17 @@ vertices held in place. A vertex may belong to one group only.)")
           py::arg("transforms"),
           R"(The deformed mesh (n, 3) for one 4 x 4 affine transform per handle group (a list, a
 (k, 4, 4) array, or one matrix for one group).)")
+      .def(
+          "base_miss",
+          [](Deformer& d) {
+            const std::lock_guard lock(d.mutex);
+            const ConstraintError& e = d.deformer->base_miss();
+            return py::dict(py::arg("max") = e.max, py::arg("rms") = e.rms);
+          },
+          R"(How far the last solve() itself was from the handles and fixed vertices: the
+deformed smooth base's distances to its targets over the bounding-box diagonal, {"max", "rms"}.
+Soft constraints miss by what their weight allows; the detailed result's constrained vertices are
+put on their targets (constraint_error).)")
       .def(
           "constraint_error",
           [](Deformer& d, py::handle X) {

@@ -241,7 +241,10 @@ map). Raises OSError if the file cannot be opened, InputError if it is malformed
       "write_mesh",
       [](const std::filesystem::path& path, py::handle V, py::handle F, const MeshReadInfo* info) {
         check_writable(path);
-        TriangleMesh mesh = to_mesh(V, F);
+        // Any coordinates can be written (to_mesh would refuse those beyond what is computed in).
+        TriangleMesh mesh;
+        mesh.V = to_vertices(V);
+        mesh.F = to_faces(F, mesh.V.rows());
         if (info != nullptr) {
           if (mesh.num_vertices() != static_cast<int>(info->vertex_to_file.size())) {
             throw InputError("write_mesh: V has " + std::to_string(mesh.num_vertices()) +

@@ -110,6 +110,7 @@ Faces to_faces(py::handle F, Eigen::Index n, const char* name) {
 TriangleMesh to_mesh(py::handle V, py::handle F) {
   TriangleMesh mesh;
   mesh.V = to_vertices(V);
+  check_coordinate_range(mesh.V, "V");
   mesh.F = to_faces(F, mesh.V.rows());
   if (mesh.F.rows() == 0) throw InputError("F: the mesh has no faces");
   return mesh;

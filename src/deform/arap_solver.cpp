@@ -87,7 +87,7 @@ ArapState iterate(const Space& space, ArapState start, double scale, const ArapO
   std::deque<Pair> history;
   ArapReport r;
   Iterate current = local(std::move(start.x), std::move(start.rotations));
-  const double floor = 1e-14 * std::max(current.energy, scale);
+  const double floor = std::max(options.energy_floor * scale, 1e-14 * current.energy);
   std::vector<double> alpha;
   while (r.iterations < options.max_iterations) {
     ++r.iterations;
@@ -122,7 +122,7 @@ ArapState iterate(const Space& space, ArapState start, double scale, const ArapO
       history.push_back(std::move(pair));
       if (static_cast<int>(history.size()) > options.history) history.pop_front();
     }
-    r.relative_change = (current.energy - next.energy) / std::max(next.energy, floor);
+    r.relative_change = (current.energy - next.energy) / std::max(current.energy, floor);
     current = std::move(next);
     if (current.energy <= floor || r.relative_change <= options.tolerance) {
       r.converged = true;

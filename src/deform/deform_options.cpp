@@ -49,6 +49,8 @@ void DeformOptions::validate() const {
   require(std::isfinite(arap.tolerance) && arap.tolerance >= 0,
           "the ARAP tolerance must be a finite number >= 0");
   require(arap.history >= 0 && arap.history <= 50, "the ARAP history must be in [0, 50]");
+  require(std::isfinite(arap.energy_floor) && arap.energy_floor >= 0 && arap.energy_floor < 1,
+          "the ARAP energy floor must be in [0, 1)");
   require(!(single_solve && background_transfer),
           "single_solve and background_transfer exclude each other");
 }

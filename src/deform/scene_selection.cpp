@@ -2,6 +2,7 @@
 // groups, and selections moved from the file's numbering to the loaded mesh's (scene.h).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 
 #include "scene_internal.h"
@@ -47,8 +48,18 @@ Eigen::Affine3d checked_transform(const Eigen::Matrix4d& m, const std::string& w
   if (m.row(3) != Eigen::RowVector4d(0, 0, 0, 1)) {
     throw InputError(where + ": the transform's last row must be 0 0 0 1");
   }
+  // Entries beyond 1e100 (a scale of 1e300) would overflow the determinant and every squared
+  // length after it: said as such, not as "not invertible".
   const Eigen::Matrix3d linear = m.topLeftCorner<3, 3>();
-  if (!(std::abs(linear.determinant()) > 1e-12 * std::pow(linear.norm(), 3))) {
+  const double largest = linear.cwiseAbs().maxCoeff();
+  if (largest > 1e100) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", largest);
+    throw InputError(where + ": the transform's linear part reaches " + text +
+                     ", out of range (at most 1e100)");
+  }
+  const Eigen::Matrix3d unit = linear / (largest > 0 ? largest : 1.0);
+  if (!(std::abs(unit.determinant()) > 1e-12 * std::pow(unit.norm(), 3))) {
     throw InputError(where + ": the transform is not invertible");
   }
   return Eigen::Affine3d(m);

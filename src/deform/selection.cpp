@@ -17,15 +17,16 @@ constexpr double kLargestMove = 1e6;
 }  // namespace
 
 ConstrainedSet constrained_set(const Selection& selection, const TriangleMesh& mesh,
-                               UnconstrainedPieces pieces, const std::vector<int>& file_index) {
+                               UnconstrainedPieces pieces, const std::vector<int>& file_index,
+                               std::string_view name) {
   int count = 0;
   const Eigen::VectorXi components = vertex_components(mesh, &count);
-  return constrained_set(selection, components, count, pieces, file_index);
+  return constrained_set(selection, components, count, pieces, file_index, name);
 }
 
 ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi& label,
                                int components, UnconstrainedPieces pieces,
-                               const std::vector<int>& file_index) {
+                               const std::vector<int>& file_index, std::string_view name) {
   const int n = static_cast<int>(label.size());
   const auto vertex = [&](int v) {
     return "vertex " + std::to_string(file_index.empty() ? v : file_index[v]);
@@ -35,12 +36,16 @@ ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi
   std::vector<int> owner(n, -2);
   const auto add = [&](int v, int group) {
     if (v < 0 || v >= n) {
-      throw InputError("selection: vertex " + std::to_string(v) +
+      throw InputError(std::string(name) + ": vertex " + std::to_string(v) +
                        " is out of range (the mesh has " + std::to_string(n) + " vertices)");
     }
     if (owner[v] != -2) {
       if (owner[v] == group) return;  // listed twice in the same group
-      throw InputError("selection: " + vertex(v) + " belongs to two groups");
+      const auto which = [](int g) {
+        return g < 0 ? std::string("the fixed set") : "handle group " + std::to_string(g);
+      };
+      throw InputError(std::string(name) + ": " + vertex(v) + " is in " + which(owner[v]) +
+                       " and in " + which(group) + " (a vertex belongs to one of them)");
     }
     owner[v] = group;
     set.vertices.push_back(v);
@@ -49,7 +54,7 @@ ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi
   for (int g = 0; g < set.num_groups; ++g)
     for (const int v : selection.handles[g]) add(v, g);
   for (const int v : selection.fixed) add(v, -1);
-  if (set.vertices.empty()) throw InputError("selection: no handle and no fixed vertex");
+  if (set.vertices.empty()) throw InputError(std::string(name) + ": no handle and no fixed vertex");
   std::vector<char> pinned(components, 0);
   for (const int v : set.vertices) pinned[label[v]] = 1;
   std::vector<int> size(components, 0), first(components, -1);
@@ -60,8 +65,8 @@ ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi
   for (int c = 0; c < components; ++c) {
     if (pinned[c]) continue;
     if (pieces == UnconstrainedPieces::Error) {
-      throw InputError("selection: connected component " + std::to_string(c + 1) + " of " +
-                       std::to_string(components) + " (" + std::to_string(size[c]) +
+      throw InputError(std::string(name) + ": connected component " + std::to_string(c + 1) +
+                       " of " + std::to_string(components) + " (" + std::to_string(size[c]) +
                        " vertices, the first " + vertex(first[c]) +
                        ") has no handle or fixed vertex, so its position is undefined");
     }

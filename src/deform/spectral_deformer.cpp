@@ -1,6 +1,8 @@
 #include "specdeform/deform/spectral_deformer.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "deform/free_pieces.h"
 #include "deform/reduced_forms.h"
@@ -191,9 +193,19 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
     deformed_base_ = base_ + state_.x;
     frame_.inverse_transform = clock.lap();
   }
+  const std::vector<int>& constrained = constrained_.vertices;
+  base_miss_ = ConstraintError{};
+  for (size_t i = 0; i < constrained_.first_free; ++i) {
+    const double d = (deformed_base_.row(constrained[i]) - base_targets.row(i)).norm();
+    base_miss_.max = std::max(base_miss_.max, d);
+    base_miss_.rms += d * d;
+  }
+  const double diagonal = bounding_box_diagonal(mesh_.V);
+  base_miss_.max /= diagonal;
+  base_miss_.rms =
+      std::sqrt(base_miss_.rms / std::max<size_t>(constrained_.first_free, 1)) / diagonal;
   // Free pieces stay exactly where they are (the solvers hold them only as well as soft
   // constraints do), then follow the deformed surface around them.
-  const std::vector<int>& constrained = constrained_.vertices;
   for (size_t i = constrained_.first_free; i < constrained.size(); ++i)
     deformed_base_.row(constrained[i]) = base_.row(constrained[i]);
   double deferred = 0.0;

@@ -24,6 +24,7 @@ std::string rewrite_obj(const MeshFile& file, const Vertices& positions,
   const ObjLayout& layout = layout_of<ObjLayout>(file);
   const std::vector<size_t> none;
   const std::vector<size_t>& vn = normals.rows() > 0 ? layout.vn : none;
+  const NumberText style = TextRewriter(file.layout->bytes).precision(layout.v, 3);
   return rewrite_text(file.layout->bytes, [&](TextRewriter& out, size_t from, size_t to) {
     // The v and vn lines in [from, to), in file order.
     const auto first = [&](const std::vector<size_t>& lines, size_t offset) {
@@ -34,7 +35,7 @@ std::string rewrite_obj(const MeshFile& file, const Vertices& positions,
     while (v < v_end || n < n_end) {
       if (n >= n_end || (v < v_end && layout.v[v] < vn[n])) {
         out.seek(layout.v[v]);
-        for (int k = 0; k < 3; ++k) out.replace(positions(Eigen::Index(v), k), NumberText::Auto);
+        for (int k = 0; k < 3; ++k) out.replace(positions(Eigen::Index(v), k), style);
         ++v;
       } else {
         out.seek(vn[n]);
@@ -48,6 +49,7 @@ std::string rewrite_obj(const MeshFile& file, const Vertices& positions,
 std::string rewrite_off(const MeshFile& file, const Vertices& positions,
                         const Eigen::MatrixX3d& normals) {
   const OffLayout& layout = layout_of<OffLayout>(file);
+  const NumberText style = TextRewriter(file.layout->bytes).precision(layout.vertex, 3);
   return rewrite_text(file.layout->bytes, [&](TextRewriter& out, size_t from, size_t to) {
     const auto at = [&](size_t offset) {
       return size_t(std::lower_bound(layout.vertex.begin(), layout.vertex.end(), offset) -
@@ -55,7 +57,7 @@ std::string rewrite_off(const MeshFile& file, const Vertices& positions,
     };
     for (size_t i = at(from), end = at(to); i < end; ++i) {
       out.seek(layout.vertex[i]);
-      for (int k = 0; k < 3; ++k) out.replace(positions(Eigen::Index(i), k), NumberText::Auto);
+      for (int k = 0; k < 3; ++k) out.replace(positions(Eigen::Index(i), k), style);
       if (layout.normals && normals.rows() > 0) {
         for (int k = 0; k < 3; ++k) out.replace(normals(Eigen::Index(i), k), NumberText::Float);
       }

@@ -90,6 +90,10 @@ LoadedMesh build_mesh(PolygonSoup soup, const std::string& name) {
       }
     }
   }
+  check_coordinate_range(
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(soup.xyz.data(),
+                                                                                  nv, 3),
+      name);
   LoadedMesh out;
   MeshReadInfo& info = out.info;
   info.file_faces = soup.num_polygons();
@@ -237,11 +241,21 @@ LoadedMesh read_mesh(const std::filesystem::path& path, const ReadOptions& optio
   if (std::filesystem::is_directory(path, ec)) throw InputError(path.string() + ": is a directory");
   std::ifstream file(path, std::ios::binary);
   if (!file) throw InputError(path.string() + ": cannot open file");
-  std::string bytes;  // reserved when the size is known (not for a pipe): no regrowth
-  if (const auto size = std::filesystem::file_size(path, ec); !ec) bytes.reserve(size);
+  std::string bytes;
+  const auto size = std::filesystem::file_size(path, ec);  // unknown for a pipe
   std::vector<char> chunk(1 << 20);
-  while (file.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || file.gcount() > 0)
-    bytes.append(chunk.data(), static_cast<size_t>(file.gcount()));
+  bool first = true;
+  while (file.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || file.gcount() > 0) {
+    const std::string_view piece(chunk.data(), static_cast<size_t>(file.gcount()));
+    if (first && !ec) {
+      // A binary STL's first triangles are checked before the rest is read: a garbage file is
+      // refused at once. The buffer then takes the whole file (no regrowth).
+      if (format == MeshFormat::Stl) detail::check_stl_start(piece, size, path.string());
+      bytes.reserve(size);
+    }
+    first = false;
+    bytes.append(piece);
+  }
   if (file.bad()) throw InputError(path.string() + ": read error");
   ReadOptions o = options;
   if (!o.companions) o.companions = folder_resolver(path.parent_path());

@@ -301,8 +301,13 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name, KeptRecord
           continue;
         }
         const double count = in.read(p.count_type, "a list length");
-        if (!(count >= 0) || count > static_cast<double>(in.remaining())) {
+        if (!(count >= 0) || count != std::floor(count)) {
           throw InputError(name + ": bad list length in element '" + e.name + "'");
+        }
+        if (count > static_cast<double>(in.remaining())) {  // each value takes a byte at least
+          throw InputError(name + ": truncated data (element '" + e.name + "' entry " +
+                           std::to_string(r) + "'s list of " + std::to_string(long(count)) +
+                           " values runs past the end)");
         }
         const bool is_face = &e == face && int(i) == face_list;
         const bool is_strip = &e == strips && int(i) == strip_list;

@@ -1,4 +1,5 @@
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -11,11 +12,16 @@ namespace specdeform::detail {
 
 namespace {
 
-// Merges exactly coincident corners into one vertex.
+// Merges exactly coincident corners into one vertex; a NaN or infinite coordinate stops the
+// reading at once, naming its triangle (a garbage file is not read to its end first).
 class Welder {
  public:
-  explicit Welder(PolygonSoup& soup) : soup_(soup) {}
+  Welder(PolygonSoup& soup, const std::string& name) : soup_(soup), name_(name) {}
   void add_corner(double x, double y, double z) {
+    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+      throw InputError(name_ + ": triangle " + std::to_string(soup_.num_polygons()) +
+                       " has a NaN or infinite coordinate");
+    }
     // Adding +0.0 turns -0.0 into +0.0, so the two zeros weld.
     const std::array<double, 3> p{x + 0.0, y + 0.0, z + 0.0};
     const auto [it, inserted] = index_.try_emplace(p, soup_.num_vertices());
@@ -29,6 +35,7 @@ class Welder {
 
  private:
   PolygonSoup& soup_;
+  const std::string& name_;
   std::unordered_map<std::array<double, 3>, int, PositionHash> index_;
 };
 
@@ -43,7 +50,7 @@ PolygonSoup parse_binary(std::string_view data, const std::string& name, KeptRec
   }
   if (count == 0) throw InputError(name + ": no faces (binary STL with 0 triangles)");
   PolygonSoup soup;
-  Welder welder(soup);
+  Welder welder(soup, name);
   if (keep) keep->attributes.normals.resize(count, 3);
   for (uint32_t t = 0; t < count; ++t) {
     const char* rec = data.data() + 84 + 50 * size_t{t};
@@ -60,7 +67,7 @@ PolygonSoup parse_binary(std::string_view data, const std::string& name, KeptRec
 PolygonSoup parse_ascii(std::string_view data, const std::string& name, KeptRecord* keep) {
   TextScanner in(data, name);
   PolygonSoup soup;
-  Welder welder(soup);
+  Welder welder(soup, name);
   bool in_loop = false;
   StlLayout layout;
   layout.ascii = true;
@@ -124,6 +131,27 @@ PolygonSoup parse_stl_soup(std::string_view data, const std::string& name, KeptR
 }
 
 }  // namespace
+
+void check_stl_start(std::string_view start, uint64_t size, const std::string& name) {
+  if (start.size() < 84) return;
+  uint32_t count = 0;
+  std::memcpy(&count, start.data() + 80, 4);
+  const size_t first = start.find_first_not_of(" \t\r\n");
+  const bool says_solid =
+      first != std::string_view::npos && start.substr(first).starts_with("solid");
+  if (says_solid && size != 84 + 50 * uint64_t{count}) return;  // ASCII
+  const uint64_t whole = std::min<uint64_t>(count, (start.size() - 84) / 50);
+  for (uint64_t t = 0; t < whole; ++t) {
+    float p[12];
+    std::memcpy(p, start.data() + 84 + 50 * t, sizeof p);
+    for (int k = 3; k < 12; ++k) {
+      if (!std::isfinite(p[k])) {
+        throw InputError(name + ": triangle " + std::to_string(t) +
+                         " has a NaN or infinite coordinate");
+      }
+    }
+  }
+}
 
 PolygonSoup parse_stl(std::string_view data, const std::string& name, KeptRecord* keep) {
   PolygonSoup soup = parse_stl_soup(data, name, keep);

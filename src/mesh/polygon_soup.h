@@ -34,6 +34,10 @@ struct KeptRecord {
   FileLayout layout;
 };
 
+// The first bytes of an STL file of `size` bytes: a binary one's triangles there are checked for
+// NaN and infinite coordinates before the rest is read (a garbage file is refused at once).
+void check_stl_start(std::string_view start, uint64_t size, const std::string& name);
+
 // Each reader throws InputError("<name>: <problem>") for malformed data; with `keep`, it records
 // the file there as well.
 PolygonSoup parse_obj(std::string_view data, const std::string& name, KeptRecord* keep);

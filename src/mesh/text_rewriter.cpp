@@ -83,9 +83,6 @@ void TextRewriter::replace(double value, NumberText style) {
   const size_t end = token_end(start);
   const std::string_view token = source_.substr(start, end - start);
   const double old = read_number(token);
-  if (style == NumberText::Auto) {
-    style = significant_digits(token) <= 9 ? NumberText::Float : NumberText::Double;
-  }
   char buf[40];
   std::to_chars_result written{};
   // The token stays where it reads back as the value (exactly, or in its style's precision).
@@ -108,6 +105,18 @@ void TextRewriter::replace(double value, NumberText style) {
     out_.append(buf, written.ptr);
   }
   pos_ = end;
+}
+
+NumberText TextRewriter::precision(const std::vector<size_t>& offsets, int count) const {
+  for (const size_t offset : offsets) {
+    size_t p = offset;
+    for (int k = 0; k < count; ++k) {
+      const size_t start = token_start(p);
+      p = token_end(start);
+      if (significant_digits(source_.substr(start, p - start)) > 9) return NumberText::Double;
+    }
+  }
+  return NumberText::Float;
 }
 
 std::string TextRewriter::finish(size_t end) {

@@ -6,11 +6,11 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace specdeform::detail {
 
 enum class NumberText {
-  Auto,     // as Float where the file's own number has 9 significant digits or fewer, else Double
   Float,    // the shortest text that reads back to the same float32
   Double,   // the shortest text that reads back to the same double
   Integer,  // rounded to the nearest integer
@@ -34,6 +34,10 @@ class TextRewriter {
   // it reads back as `value` written in `style`.
   void replace(double value, NumberText style);
   size_t position() const { return pos_; }
+  // Double where any of the `count` tokens from any of `offsets` has more than 9 significant
+  // digits (a file written in double precision), else Float (written from single precision,
+  // as most are): how the file's new positions are written.
+  NumberText precision(const std::vector<size_t>& offsets, int count) const;
   // The source up to `end` appended; the text.
   std::string finish(size_t end = std::string_view::npos);
 

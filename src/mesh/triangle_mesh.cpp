@@ -1,8 +1,12 @@
 #include "specdeform/mesh/triangle_mesh.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <string>
 
 #include <Eigen/Geometry>
+
+#include "specdeform/exceptions.h"
 
 namespace specdeform {
 
@@ -11,6 +15,27 @@ bool is_degenerate_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
   const double longest =
       std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
   return (b - a).cross(c - a).norm() <= kDegenerateTolerance * longest;
+}
+
+void check_coordinate_range(const Eigen::Ref<const Eigen::MatrixXd>& V, std::string_view name) {
+  if (V.size() == 0) return;
+  const auto number = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return std::string(text);
+  };
+  const double largest = V.cwiseAbs().maxCoeff();
+  if (largest > kLargestCoordinate) {
+    throw InputError(std::string(name) + ": coordinates reach " + number(largest) +
+                     ", beyond the range computed in (extents of 1e-100 to 1e100): rescale the "
+                     "mesh");
+  }
+  const double extent = (V.colwise().maxCoeff() - V.colwise().minCoeff()).maxCoeff();
+  if (extent > 0 && extent < kSmallestExtent) {
+    throw InputError(std::string(name) + ": the mesh spans only " + number(extent) +
+                     ", below the range computed in (extents of 1e-100 to 1e100): rescale the "
+                     "mesh");
+  }
 }
 
 double bounding_box_diagonal(const Vertices& V) {

@@ -111,7 +111,12 @@ TEST(ArapSolver, ReproducesRigidMotions) {
     deformer.set_selection(both_ends);
     const Vertices out = deformer.solve({motion});
     EXPECT_LT(point_distances(out, expected).max, 1e-6 * diagonal) << static_cast<int>(solver);
-    EXPECT_TRUE(deformer.arap_report().converged);
+    // A rigid motion ends with an energy of rounding noise: its change is read against the
+    // floor, not against itself (it read -0.171 or 427 before): the fraction of the energy the
+    // last step removed, at most 1.
+    const ArapReport& r = deformer.arap_report();
+    EXPECT_TRUE(r.converged);
+    EXPECT_LE(std::abs(r.relative_change), 1.0) << r.relative_change;
   }
   DeformOptions linear;
   linear.energy = DeformEnergy::Linear;

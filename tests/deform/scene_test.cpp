@@ -73,6 +73,14 @@ TEST_F(SceneFiles, BadScenesGiveOneLine) {
             V);
       },
       "not invertible");
+  // Invertible, but beyond what lengths can be computed in: said so.
+  expect(
+      [&] {
+        read_scene(write("e.json",
+                         "{\"handles\": [{\"vertices\": [0], \"transform\": {\"scale\": 1e300}}]}"),
+                   V);
+      },
+      "out of range");
 }
 
 TEST_F(SceneFiles, DefWithoutCommentLineAndSelComments) {

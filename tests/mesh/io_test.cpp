@@ -38,7 +38,7 @@ TriangleMesh awkward_coordinates() {
   m.V(0, 0) = 0.1;
   m.V(1, 1) = 1.0 / 3.0;
   m.V(2, 2) = -std::numeric_limits<double>::denorm_min();
-  m.V(3, 0) = 1e300;
+  m.V(3, 0) = 1e90;
   return m;
 }
 
@@ -380,6 +380,10 @@ TEST(MeshIo, ClearErrors) {
   std::string truncated = tetra_ply("binary_little_endian", "float", "uchar", "int");
   truncated.resize(truncated.size() - 20);
   expect_error(truncated, MeshFormat::Ply, "truncated");
+  // Cut 2 bytes after the last face's count: truncated, not "bad list length".
+  std::string cut = encode_mesh(make_icosphere(0), MeshFormat::Ply);
+  cut.resize(cut.size() - 13 + 2);
+  expect_error(cut, MeshFormat::Ply, "truncated data (element 'face' entry 19's list of 3");
   expect_error("ply\nformat ascii 1.0\n", MeshFormat::Ply, "end_header");
   expect_error(
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
@@ -396,6 +400,43 @@ TEST(MeshIo, ClearErrors) {
 }
 
 // Every file of ../shared/meshes/awkward gives a mesh or one clear error line.
+// Coordinates beyond what squared lengths hold, or extents below it: one error naming the range,
+// not a blame of degenerate faces later.
+TEST(MeshIo, CoordinatesOutOfRangeAreNamed) {
+  for (const auto& [scale, fragment] :
+       {std::pair{1e160, "coordinates reach 1e+160"}, std::pair{1e-300, "spans only"}}) {
+    TriangleMesh m = make_icosphere(1);
+    m.V *= scale;
+    expect_error(encode_mesh(m, MeshFormat::Obj), MeshFormat::Obj, fragment);
+  }
+  TriangleMesh far = make_icosphere(1);
+  far.V.array() += 1e6;  // far from the origin, of an ordinary size: fine
+  EXPECT_NO_THROW(parse(encode_mesh(far, MeshFormat::Obj), MeshFormat::Obj));
+}
+
+// A garbage binary STL stops at its first bad value (before welding the rest), and a file read
+// from disk is refused after its first megabyte, not after reading all of it.
+TEST(MeshIo, GarbageStlStopsAtItsFirstBadValue) {
+  std::string stl = encode_mesh(make_icosphere(5), MeshFormat::Stl);  // 20,480 triangles, 1 MB
+  const float nan = std::nanf("");
+  std::memcpy(stl.data() + 84 + 50 * 21 + 12 + 4, &nan, 4);
+  expect_error(stl, MeshFormat::Stl, "triangle 21 has a NaN");
+  const auto path = std::filesystem::temp_directory_path() / "specdeform_garbage.stl";
+  std::string big = stl.substr(0, 84);
+  const uint32_t count = 400'000;  // 20 MB
+  std::memcpy(big.data() + 80, &count, 4);
+  big += stl.substr(84);
+  big.resize(84 + 50 * size_t{count}, '\x7f');  // 0x7f7f7f7f: a finite float, if read
+  std::ofstream(path, std::ios::binary) << big;
+  try {
+    read_mesh(path);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("triangle 21 has a NaN"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(path);
+}
+
 TEST(MeshIo, AwkwardCorpus) {
   const auto shared = test::shared_dir();
   if (shared.empty()) GTEST_SKIP() << "../shared is absent: awkward corpus not available";

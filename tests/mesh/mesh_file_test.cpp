@@ -117,20 +117,24 @@ TEST(MeshFile, ObjMovedKeepsEveryOtherLine) {
   }
 }
 
-// Numbers that did not change keep their text; new ones are as short as their precision allows:
-// float32 where the file wrote 9 digits or fewer, double otherwise.
+// Numbers that did not change keep their text; new ones are as short as the file's precision
+// allows: float32 for a file whose positions have 9 significant digits or fewer, double where one
+// has more (a file written in double precision has round values too: 0.5, 1).
 TEST(MeshFile, NumbersKeepTheirTextAndPrecision) {
-  const std::string text = "v 0.100000 1.0 +2\nv 0.12345678901234 0 0\nv 0 1 0\nf 1 2 3\n";
-  const LoadedMesh m = keep(text, MeshFormat::Obj);
-  EXPECT_EQ(write(m, m.file->rest, "a.obj"), text);
-  Vertices X = m.file->rest;
-  X(0, 0) = 0.3;
-  X(1, 0) = 0.3;
-  EXPECT_EQ(write(m, X, "a.obj"), "v 0.3 1.0 +2\nv 0.3 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::string single = "v 0.100000 1.0 +2\nv 0.123457 0 0\nv 0 1 0\nf 1 2 3\n";
+  const LoadedMesh a = keep(single, MeshFormat::Obj);
+  EXPECT_EQ(write(a, a.file->rest, "a.obj"), single);
+  Vertices X = a.file->rest;
   X(0, 0) = 1.0 / 3.0;
-  X(1, 0) = 1.0 / 3.0;
-  EXPECT_EQ(write(m, X, "a.obj"),
-            "v 0.33333334 1.0 +2\nv 0.3333333333333333 0 0\nv 0 1 0\nf 1 2 3\n");
+  X(1, 0) = 0.3;
+  EXPECT_EQ(write(a, X, "a.obj"), "v 0.33333334 1.0 +2\nv 0.3 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::string full = "v 0.5 1 0\nv 0.12345678901234 0 0\nv 0 1 0\nf 1 2 3\n";
+  const LoadedMesh b = keep(full, MeshFormat::Obj);
+  EXPECT_EQ(write(b, b.file->rest, "b.obj"), full);
+  X = b.file->rest;
+  X(0, 0) = 1.0 / 3.0;
+  EXPECT_EQ(write(b, X, "b.obj"),
+            "v 0.3333333333333333 1 0\nv 0.12345678901234 0 0\nv 0 1 0\nf 1 2 3\n");
 }
 
 // Line continuations are kept joined; the rest of the file as it was.

@@ -217,6 +217,8 @@ def test_report_timings_and_options(bar):
                             "frame"}
     assert deformer.options["energy"] == "arap" and deformer.options["clusters"] == 40
     assert deformer.constraint_error(X)["max"] < 1e-9  # transfer anchors the handles exactly
+    miss = deformer.base_miss()  # what the solve itself missed by: soft constraints, not zero
+    assert 0 < miss["rms"] <= miss["max"] < 0.005
     assert deformer.deformed_base.shape == X.shape and deformer.deformed_base.flags.writeable
 
 
@@ -271,6 +273,14 @@ def test_concurrent_solves_on_one_deformer(bar):
             np.testing.assert_allclose(results[i][j], expected[(i + j) % 4], atol=1e-12)
 
 
+def test_coordinates_out_of_range_are_named():
+    V, F = specdeform.icosphere(1)
+    with pytest.raises(specdeform.InputError, match=r"coordinates reach 1e\+160"):
+        specdeform.SpectralDeformer(V * 1e160, F, 10)
+    with pytest.raises(specdeform.InputError, match="spans only"):
+        specdeform.SpectralDeformer(V * 1e-300, F, 10)
+
+
 @pytest.mark.parametrize(
     "call, message",
     [
@@ -282,6 +292,10 @@ def test_concurrent_solves_on_one_deformer(bar):
         (lambda d, n: d.set_selection([[1, 2]], [2]), "2"),
         (lambda d, n: d.set_selection([np.ones(n - 1, bool)]), "boolean mask needs one entry"),
         (lambda d, n: d.set_selection("abc"), "handles: expected a list"),
+        # An empty group, no group, an empty second group: refused, not a silent identity.
+        (lambda d, n: d.set_selection([np.array([], int)], [0]), r"handles\[0\]: an empty handle group"),
+        (lambda d, n: d.set_selection([], [0]), "handles: no handle group"),
+        (lambda d, n: d.set_selection([[1, 2], np.zeros(n, bool)]), r"handles\[1\]: an empty handle group"),
         (lambda d, n: d.solve([np.eye(4)] * 2), "transform"),
         (lambda d, n: d.solve(np.eye(3)), "4 x 4"),
         (lambda d, n: d.solve(np.diag([1, 1, 1, 2.0])), "transform 0"),

@@ -483,7 +483,7 @@ export class Panel {
       ['drag → drawn (median)', stats.latencies.length ? `${median(stats.latencies.slice(-30)).toFixed(0)} ms` : '–'],
       ['updates drawn per second', `${lastSecond}`],
       ['full draw / preview', s.drawMs ? `${s.drawMs.toFixed(0)} ms / ${s.previewWanted ? `${s.viewer.previewSize.toLocaleString()} vertices` : 'off'}` : '–'],
-      ['handle error / diagonal', f ? f.error.max.toExponential(1) : '–'],
+      ['smooth base misses the handles by', f ? `${(100 * f.error.max).toPrecision(2)}% of the diagonal` : '–'],
     ];
     $('timings').replaceChildren(...rows.map(([k, v]) => {
       const tr = document.createElement('tr');

@@ -136,7 +136,7 @@ export interface FrameResult {
   preview: boolean; // positions of the preview's vertices only
   foldZone: boolean; // the smooth base folded: details added as displacements there
   ms: { reducedSolve: number; inverseTransform: number; detail: number; total: number };
-  error: { max: number; rms: number };
+  error: { max: number; rms: number }; // the smooth base's miss of its targets, of the diagonal
   arap: { iterations: number; converged: boolean };
   // Positions are rest positions + scale * displacements (of the preview's vertices for a
   // preview): 16 bits a coordinate.

@@ -36,8 +36,10 @@
 // 2017): without history a step is the local/global step; a step that fails the Armijo condition
 // is replaced by the local/global step, so the energy never increases. Each iteration is
 // O(k m + m^2), independent of n. They stop when an iteration lowers the energy by less than
-// `tolerance` times the energy, when the energy falls below 1e-14 of its starting value, or at
-// `max_iterations`. Energies are in the units of the mesh's lengths squared, on the unit-area
+// `tolerance` times the energy, or times `energy_floor` of the base's Dirichlet energy where the
+// energy is smaller (a piece that only moves rigidly has an energy of rounding noise: measured
+// against itself, its change would read as any number), when the energy falls below that floor,
+// or at `max_iterations`. Energies are in the units of the mesh's lengths squared, on the unit-area
 // scale of deform_options.h.
 #pragma once
 
@@ -60,7 +62,8 @@ struct ArapReport {
   int iterations = 0;            // local/global steps taken
   int accelerated = 0;           // of which quasi-Newton (L-BFGS) steps kept
   double energy = 0.0;           // at the result
-  double relative_change = 0.0;  // the last step's decrease of the energy over the energy
+  double relative_change = 0.0;  // the fraction of the energy the last step removed (of the
+                                 // floor, where the energy was below it): at most 1
   bool converged = false;        // stopped by the tolerance, not by the cap
 };
 

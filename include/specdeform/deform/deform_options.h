@@ -49,15 +49,18 @@ enum class UnconstrainedPieces {
 
 // DeformEnergy::Arap: its bending weight, rotation clusters and iterations.
 struct ArapOptions {
-  int clusters = 200;        // rotation clusters (at least one per connected component)
-  double bending = 1e-3;     // the bending weight against the membrane's 1 (arap_solver.h)
-  int max_iterations = 100;  // a cap on the iterations per frame
-  double tolerance = 1e-4;   // stop when an iteration lowers the energy by less than this
-                             // fraction of it (see arap_solver.h)
-  int history = 5;           // L-BFGS pairs kept; 0: plain local/global steps
-  bool warm_start = false;   // start from the previous frame's solution instead of the
-                             // handles' rotations spread over the surface (interactive drags;
-                             // not for timing a cold frame)
+  int clusters = 200;           // rotation clusters (at least one per connected component)
+  double bending = 1e-3;        // the bending weight against the membrane's 1 (arap_solver.h)
+  int max_iterations = 100;     // a cap on the iterations per frame
+  double tolerance = 1e-4;      // stop when an iteration lowers the energy by less than this
+                                // fraction of it (see arap_solver.h)
+  double energy_floor = 1e-10;  // energies below this fraction of the base's Dirichlet energy
+                                // are rounding noise (rigid motion): changes are measured
+                                // against at least it
+  int history = 5;              // L-BFGS pairs kept; 0: plain local/global steps
+  bool warm_start = false;      // start from the previous frame's solution instead of the
+                                // handles' rotations spread over the surface (interactive drags;
+                                // not for timing a cold frame)
 };
 
 struct DeformOptions {

@@ -5,6 +5,7 @@
 // belong to one group only. Transforms act on positions: p -> A p + t (Eigen::Affine3d).
 #pragma once
 
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -35,15 +36,18 @@ struct ConstrainedSet {
 // Throws InputError for an empty selection, an index out of [0, n), a vertex in two groups, or,
 // under UnconstrainedPieces::Error, a connected component with no constrained vertex (the
 // message names its size and its first vertex). Messages name vertex v as file_index[v] when
-// file_index is given (the file's numbering, MeshReadInfo::vertex_to_file).
+// file_index is given (the file's numbering, MeshReadInfo::vertex_to_file), and start with
+// `name` (the scene's file, say).
 ConstrainedSet constrained_set(const Selection& selection, const TriangleMesh& mesh,
                                UnconstrainedPieces pieces = UnconstrainedPieces::Keep,
-                               const std::vector<int>& file_index = {});
+                               const std::vector<int>& file_index = {},
+                               std::string_view name = "selection");
 
 // The same with the mesh's vertex_components() computed beforehand (labels 0 .. count-1).
 ConstrainedSet constrained_set(const Selection& selection, const Eigen::VectorXi& components,
                                int count, UnconstrainedPieces pieces,
-                               const std::vector<int>& file_index = {});
+                               const std::vector<int>& file_index = {},
+                               std::string_view name = "selection");
 
 // The soft constraints' vertex weights a_i: each vertex's lumped area over its connected
 // piece's area, so that a piece weighs its constraints as it would alone (on the whole mesh's

@@ -89,8 +89,15 @@ class SpectralDeformer {
   // The deformed detailed mesh (n x 3) for one transform per handle group.
   Vertices solve(const std::vector<Eigen::Affine3d>& transforms);
 
-  // Error of `result` (a solve() output) against the targets of the last solve().
+  // Error of `result` (a solve() output) against the targets of the last solve(): 0 where the
+  // details meet them exactly (transfer, frames, displacement anchor the constrained vertices).
   ConstraintError constraint_error(const Vertices& result) const;
+
+  // How far the last solve() itself was from the handles and fixed vertices: the distances of
+  // the deformed smooth base's constrained vertices to their targets (free pieces left out),
+  // over the bounding-box diagonal. Soft constraints pull as hard as their weight; this is what
+  // they missed by.
+  const ConstraintError& base_miss() const { return base_miss_; }
 
   const TriangleMesh& mesh() const { return mesh_; }
   const std::shared_ptr<const ManifoldHarmonics>& basis() const { return basis_; }
@@ -146,6 +153,7 @@ class SpectralDeformer {
   ArapState state_;                  // c (spectral) or d (spatial) of the last solve, and
                                      // ARAP's rotations
   Eigen::MatrixX3d detail_targets_;  // targets of the last solve, for constraint_error
+  ConstraintError base_miss_;
   ArapReport arap_report_;
   SetupTimings setup_;
   FrameTimings frame_;

@@ -7,8 +7,9 @@
 //  - into the input's format, the same file with only positions, normals (and glTF tangents and
 //    POSITION min/max) changed; every other line, property, byte and chunk as it was, in order. A
 //    number whose value did not change keeps its text; a new one is written as the shortest text
-//    that reads back to it (to float32 where the file's own number was at float32 precision or
-//    less, to double otherwise); binary values in the file's own type and byte order.
+//    that reads back to it: to double where any of the file's positions has more than 9
+//    significant digits (written in double precision), to float32 otherwise (written from single
+//    precision, as most are); binary values in the file's own type and byte order.
 //  - into another format, what that format can hold (polygons, texture coordinates, normals,
 //    colours, material names), naming each thing it drops in EncodedMesh::notes.
 // A normal none of whose faces moved is written as it was. glTF tangents follow their faces'

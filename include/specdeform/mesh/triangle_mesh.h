@@ -5,6 +5,8 @@
 // const references and never modify their input.
 #pragma once
 
+#include <string_view>
+
 #include <Eigen/Core>
 
 namespace specdeform {
@@ -26,6 +28,13 @@ struct TriangleMesh {
 inline constexpr double kDegenerateTolerance = 1e-12;
 bool is_degenerate_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                             const Eigen::Vector3d& c);
+
+// The coordinates this library computes in: squared lengths, areas and volumes of coordinates
+// beyond 1e100 overflow and of extents below 1e-100 vanish. Throws InputError "<name>:
+// coordinates reach 1e+160 ..." (or "... span only 1e-300 ...") outside them; the readers and the
+// bindings check what comes in.
+inline constexpr double kLargestCoordinate = 1e100, kSmallestExtent = 1e-100;
+void check_coordinate_range(const Eigen::Ref<const Eigen::MatrixXd>& V, std::string_view name);
 
 // Length of the diagonal of the axis-aligned bounding box (0 for an empty mesh).
 double bounding_box_diagonal(const Vertices& V);
