@@ -30,6 +30,8 @@ struct OffLayout {
 enum class PlyScalar { I8, U8, I16, U16, I32, U32, F32, F64 };
 size_t ply_scalar_size(PlyScalar s);
 const char* ply_scalar_name(PlyScalar s);
+// The binary value of type `s` at `bytes`, stored big- or little-endian, as a double.
+double ply_binary_value(const char* bytes, PlyScalar s, bool big_endian);
 
 struct PlyProperty {
   std::string name;

@@ -78,31 +78,9 @@ NumberText text_style(PlyScalar s) {
 // NaN payloads).
 class BinaryValue {
  public:
-  BinaryValue(std::string& bytes, bool big_endian) : bytes_(bytes), swap_(big_endian) {}
+  BinaryValue(std::string& bytes, bool big_endian) : bytes_(bytes), big_(big_endian) {}
 
-  double get(size_t at, PlyScalar s) const {
-    unsigned char b[8];
-    load(at, ply_scalar_size(s), b);
-    switch (s) {
-      case PlyScalar::I8:
-        return as<int8_t>(b);
-      case PlyScalar::U8:
-        return as<uint8_t>(b);
-      case PlyScalar::I16:
-        return as<int16_t>(b);
-      case PlyScalar::U16:
-        return as<uint16_t>(b);
-      case PlyScalar::I32:
-        return as<int32_t>(b);
-      case PlyScalar::U32:
-        return as<uint32_t>(b);
-      case PlyScalar::F32:
-        return as<float>(b);
-      case PlyScalar::F64:
-        return as<double>(b);
-    }
-    return 0;
-  }
+  double get(size_t at, PlyScalar s) const { return ply_binary_value(bytes_.data() + at, s, big_); }
 
   void set(size_t at, PlyScalar s, double v) {
     switch (s) {
@@ -126,17 +104,6 @@ class BinaryValue {
   }
 
  private:
-  void load(size_t at, size_t size, unsigned char* b) const {
-    std::memcpy(b, bytes_.data() + at, size);
-    if (swap_ != (std::endian::native == std::endian::big))
-      for (size_t i = 0; i < size / 2; ++i) std::swap(b[i], b[size - 1 - i]);
-  }
-  template <typename T>
-  static double as(const unsigned char* b) {
-    T v;
-    std::memcpy(&v, b, sizeof v);
-    return static_cast<double>(v);
-  }
   template <typename T>
   void put(size_t at, PlyScalar s, double v) {
     const T value = checked_cast<T>(v, "a PLY value");
@@ -144,13 +111,12 @@ class BinaryValue {
     if (static_cast<double>(value) == stored || (std::isnan(v) && std::isnan(stored))) return;
     unsigned char b[sizeof(T)];
     std::memcpy(b, &value, sizeof value);
-    if (swap_ != (std::endian::native == std::endian::big))
-      for (size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
+    if (big_ != (std::endian::native == std::endian::big)) std::reverse(b, b + sizeof b);
     std::memcpy(bytes_.data() + at, b, sizeof b);
   }
 
   std::string& bytes_;
-  bool swap_;
+  bool big_;
 };
 
 }  // namespace

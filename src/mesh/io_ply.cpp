@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <bit>
 #include <charconv>
 #include <cmath>
@@ -28,6 +29,36 @@ size_t ply_scalar_size(PlyScalar s) {
       return 8;
   }
   return 0;
+}
+
+double ply_binary_value(const char* bytes, PlyScalar s, bool big_endian) {
+  const size_t size = ply_scalar_size(s);
+  unsigned char b[8];
+  std::memcpy(b, bytes, size);
+  if (big_endian != (std::endian::native == std::endian::big)) std::reverse(b, b + size);
+  const auto as = [&](auto v) {
+    std::memcpy(&v, b, sizeof v);
+    return static_cast<double>(v);
+  };
+  switch (s) {
+    case PlyScalar::I8:
+      return as(int8_t{});
+    case PlyScalar::U8:
+      return as(uint8_t{});
+    case PlyScalar::I16:
+      return as(int16_t{});
+    case PlyScalar::U16:
+      return as(uint16_t{});
+    case PlyScalar::I32:
+      return as(int32_t{});
+    case PlyScalar::U32:
+      return as(uint32_t{});
+    case PlyScalar::F32:
+      return as(float{});
+    case PlyScalar::F64:
+      return as(double{});
+  }
+  return 0.0;
 }
 
 const char* ply_scalar_name(PlyScalar s) {
@@ -73,31 +104,9 @@ class BodyReader {
     if (pos_ + size > body_.size()) {
       throw InputError(name_ + ": truncated binary data while reading " + what);
     }
-    unsigned char b[8];
-    std::memcpy(b, body_.data() + pos_, size);
+    const double v = ply_binary_value(body_.data() + pos_, s, enc_ == Encoding::Big);
     pos_ += size;
-    if ((enc_ == Encoding::Big) != (std::endian::native == std::endian::big)) {
-      for (size_t i = 0; i < size / 2; ++i) std::swap(b[i], b[size - 1 - i]);
-    }
-    switch (s) {
-      case Scalar::I8:
-        return static_cast<double>(static_cast<int8_t>(b[0]));
-      case Scalar::U8:
-        return b[0];
-      case Scalar::I16:
-        return as<int16_t>(b);
-      case Scalar::U16:
-        return as<uint16_t>(b);
-      case Scalar::I32:
-        return as<int32_t>(b);
-      case Scalar::U32:
-        return as<uint32_t>(b);
-      case Scalar::F32:
-        return as<float>(b);
-      case Scalar::F64:
-        return as<double>(b);
-    }
-    return 0.0;
+    return v;
   }
 
   // ASCII PLY puts one element entry on a line: values beyond the declared ones are ignored.
@@ -110,13 +119,6 @@ class BodyReader {
   size_t position() const { return enc_ == Encoding::Ascii ? text_.position() : pos_; }
 
  private:
-  template <typename T>
-  static double as(const unsigned char* b) {
-    T v;
-    std::memcpy(&v, b, sizeof(T));
-    return static_cast<double>(v);
-  }
-
   std::string_view body_;
   Encoding enc_;
   TextScanner text_;
