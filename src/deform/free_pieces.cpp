@@ -1,6 +1,8 @@
 #include "deform/free_pieces.h"
 
 #include <algorithm>
+#include <limits>
+#include <memory>
 
 #include "linalg/nearest_rotation.h"
 #include "mesh/triangle_tree.h"
@@ -29,6 +31,46 @@ Eigen::Matrix3d edge_frame(const Vertices& V, const Eigen::Vector3i& f) {
   return frame;
 }
 
+// A sample's closest point on a surface: its face, barycentric coordinates, distance and
+// weight 1 / (distance + softening)^2.
+struct Closest {
+  int face;
+  Eigen::Vector3d barycentric;
+  double distance, weight;
+};
+
+// Triangles of the driving surface (mesh face numbers beside them) and their tree, built once
+// all are added.
+class Surface {
+ public:
+  void add(const TreeTriangle& t, int face) {
+    triangles.push_back(t);
+    faces_.push_back(face);
+  }
+  void build() {
+    if (tree_ || triangles.empty()) return;
+    tree_ = std::make_unique<TriangleTree>(triangles.cbegin(), triangles.cend());
+    tree_->accelerate_distance_queries();
+  }
+  Closest closest(const TriangleMesh& mesh, int v, double softening) const {
+    const auto [q, it] = tree_->closest_point_and_primitive(tree_point(mesh.V, v));
+    const int f = faces_[it - triangles.cbegin()];
+    const Eigen::Vector3d p(q.x(), q.y(), q.z());
+    const double distance = (p - mesh.V.row(v).transpose()).norm();
+    const double d = distance + softening;
+    return {f,
+            barycentric(p, mesh.V.row(mesh.F(f, 0)), mesh.V.row(mesh.F(f, 1)),
+                        mesh.V.row(mesh.F(f, 2))),
+            distance, 1.0 / (d * d)};
+  }
+
+  std::vector<TreeTriangle> triangles;
+
+ private:
+  std::vector<int> faces_;
+  std::unique_ptr<TriangleTree> tree_;
+};
+
 }  // namespace
 
 FreePieces::FreePieces(const TriangleMesh& mesh, const Eigen::VectorXi& components,
@@ -45,37 +87,52 @@ FreePieces::FreePieces(const TriangleMesh& mesh, const Eigen::VectorXi& componen
   for (int v = 0; v < mesh.num_vertices(); ++v) {
     if (piece_of[components[v]] >= 0) pieces_[piece_of[components[v]]].vertices.push_back(v);
   }
-  std::vector<TreeTriangle> triangles;
-  std::vector<int> face_of;
+  // The driving surface, all of it and piece by piece.
+  const size_t count = driving.size();
+  Surface all;
+  std::vector<Surface> by_piece(count);
   for (int f = 0; f < mesh.num_faces(); ++f) {
-    if (!driving[components[mesh.F(f, 0)]]) continue;
+    const int c = components[mesh.F(f, 0)];
+    if (!driving[c]) continue;
     const TreeTriangle t(tree_point(mesh.V, mesh.F(f, 0)), tree_point(mesh.V, mesh.F(f, 1)),
                          tree_point(mesh.V, mesh.F(f, 2)));
     if (t.is_degenerate()) continue;
-    triangles.push_back(t);
-    face_of.push_back(f);
+    all.add(t, f);
+    by_piece[c].add(t, f);
   }
-  if (triangles.empty()) {
+  if (all.triangles.empty()) {
     throw InputError("free pieces: the constrained pieces have no triangle to follow");
   }
-  TriangleTree tree(triangles.begin(), triangles.end());
-  tree.accelerate_distance_queries();
+  all.build();
   for (Piece& piece : pieces_) {
     Eigen::AlignedBox3d box;
     for (const int v : piece.vertices) box.extend(Eigen::Vector3d(mesh.V.row(v)));
     const double softening = policy.softening * std::max(box.diagonal().norm(), 1e-300);
-    const size_t count = piece.vertices.size();
-    const size_t samples = std::min<size_t>(count, policy.samples);
-    for (size_t s = 0; s < samples; ++s) {
-      const int v = piece.vertices[s * count / samples];
-      const auto [q, it] = tree.closest_point_and_primitive(tree_point(mesh.V, v));
-      const int f = face_of[it - triangles.cbegin()];
-      const Eigen::Vector3d closest(q.x(), q.y(), q.z());
-      const double d = (closest - mesh.V.row(v).transpose()).norm() + softening;
-      piece.samples.push_back({f,
-                               barycentric(closest, mesh.V.row(mesh.F(f, 0)),
-                                           mesh.V.row(mesh.F(f, 1)), mesh.V.row(mesh.F(f, 2))),
-                               1.0 / (d * d)});
+    const size_t samples = std::min<size_t>(piece.vertices.size(), policy.samples);
+    std::vector<int> sampled(samples);
+    for (size_t s = 0; s < samples; ++s)
+      sampled[s] = piece.vertices[s * piece.vertices.size() / samples];
+    // The constrained piece it follows: the nearest one; among those within `softening` of
+    // the nearest distance (several contacts), the one it touches over the most samples'
+    // weight.
+    std::vector<double> nearest(count, std::numeric_limits<double>::infinity()), weight(count, 0);
+    for (const int v : sampled) {
+      const Closest q = all.closest(mesh, v, softening);
+      const int c = components[mesh.F(q.face, 0)];
+      nearest[c] = std::min(nearest[c], q.distance);
+      weight[c] += q.weight;
+    }
+    const double closest = *std::min_element(nearest.begin(), nearest.end());
+    int followed = -1;
+    for (size_t c = 0; c < count; ++c) {
+      if (nearest[c] <= closest + softening && (followed < 0 || weight[c] > weight[followed]))
+        followed = static_cast<int>(c);
+    }
+    Surface& surface = by_piece[followed];
+    surface.build();
+    for (const int v : sampled) {
+      const Closest q = surface.closest(mesh, v, softening);
+      piece.samples.push_back({q.face, q.barycentric, q.weight});
     }
   }
 }

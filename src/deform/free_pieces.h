@@ -2,11 +2,15 @@
 // handle or fixed vertex moves rigidly with the deformed surface around it: teeth with the
 // mouth, an eye with its socket, a wheel with its fender.
 //
-// Built once per selection. Each sample p of a free piece (its vertices, at most
-// policy.samples of them spread over it) finds its closest point q on the triangles of the
-// constrained pieces (the driving surface), weighted by w = 1 / (|p - q| + softening * r)^2, r
-// the piece's bounding-box diagonal, so that contacts and near-contacts dominate. Per frame,
-// from the driving surface's rest and deformed positions:
+// Built once per selection. A free piece follows one constrained piece, the nearest to it (of
+// several within softening * r of the nearest distance, r the free piece's bounding-box
+// diagonal, the one it touches most: the largest sum of the weights below): a part squeezed
+// between a turned cab and a bending body keeps its contact with the one it sits on, where a
+// rotation between the two would keep neither. Each sample p of the free piece (its vertices,
+// at most policy.samples of them spread over it) finds its closest point q on that piece's
+// triangles (the driving surface), weighted by w = 1 / (|p - q| + softening * r)^2, so that
+// contacts and near-contacts dominate. Per frame, from the driving surface's rest and deformed
+// positions:
 //     R = the rotation nearest to  sum_j w_j R_j,     t = sum_j w_j (q'_j - R q_j) / sum_j w_j,
 // R_j the rotation of the deformation gradient of q_j's triangle (its normal included), q'_j
 // the deformed point at q_j's barycentric coordinates. The piece moves by x -> R x + t: its
