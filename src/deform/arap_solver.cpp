@@ -206,7 +206,8 @@ Sparse curvature_weights(const Eigen::MatrixX3d& curvature, const Eigen::VectorX
 }  // namespace
 
 ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
-                       std::shared_ptr<const ManifoldHarmonics> basis, const ArapOptions& options)
+                       std::shared_ptr<const ManifoldHarmonics> basis, const ArapOptions& options,
+                       const std::vector<char>& moving)
     : options_(options) {
   if (base.rows() != mesh.num_vertices()) {
     throw InputError("ARAP: the base has " + std::to_string(base.rows()) + " vertices, the mesh " +
@@ -218,7 +219,9 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
   Eigen::VectorXd mass;
   detail::run_pair(
       [&] {
-        clusters = vertex_clusters(TriangleMesh{base, mesh.F}, options.clusters);
+        const TriangleMesh surface{base, mesh.F};
+        clusters = moving.empty() ? vertex_clusters(surface, options.clusters)
+                                  : vertex_clusters(surface, options.clusters, moving);
       },
       [&] {
         if (basis) {

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "deform/free_pieces.h"
+#include "deform/moving_basis.h"
 #include "deform/reduced_forms.h"
 #include "linalg/basis_product.h"
 #include "specdeform/deform/reduced_solver.h"
@@ -68,38 +69,23 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
   }
   Clock clock;
   components_ = vertex_components(mesh_, &num_components_);
-  piece_modes_.assign(num_components_, 0);
-  if (has_basis && num_components_ == 1) {
-    piece_modes_[0] = static_cast<int>(basis_->basis.cols());
-  } else if (has_basis) {
+  if (has_basis) {
     // A mode's piece: the piece of its largest entry (a basis of several pieces is computed
     // piece by piece, each mode on one).
-    for (Eigen::Index j = 0; j < basis_->basis.cols(); ++j) {
+    piece_of_mode_.assign(basis_->basis.cols(), 0);
+    for (Eigen::Index j = 0; j < basis_->basis.cols() && num_components_ > 1; ++j) {
       Eigen::Index i;
       basis_->basis.col(j).cwiseAbs().maxCoeff(&i);
-      ++piece_modes_[components_[i]];
+      piece_of_mode_[j] = components_[i];
     }
-  }
-  const Eigen::VectorXd area = lumped_mass(mesh_);
-  if (has_basis) {
     const Eigen::MatrixXd& H = basis_->basis;
     base_ = harmonics_inverse(H, harmonics_forward(H, mass_matrix(mesh_, basis_->mass), mesh_.V));
   } else {
     base_ = mesh_.V;
   }
-  const bool spectral = options_.solver == DeformSolver::Spectral;
-  if (options_.energy == DeformEnergy::Arap) {
-    arap_ = std::make_unique<ArapSolver>(mesh_, base_, spectral ? basis_ : nullptr, options_.arap);
-    clusters_ = arap_->clusters();
-  }
-  if (spectral) {
-    reduced_ = std::make_unique<ReducedSolver>(
-        basis_, arap_ ? arap_->reduced_hessian() : linear_hessian(mesh_, *basis_, options_),
-        piece_area_fractions(area, components_, num_components_), options_);
-    if (options_.float32_basis) basis32_ = basis_->basis.cast<float>();
-  } else {
-    spatial_ = std::make_unique<SpatialSolver>(mesh_, options_);
-  }
+  // On several pieces under soft constraints, the spectral solvers wait for the selection: they
+  // work in the modes of the pieces that move (deform/moving_basis.h).
+  if (!by_moving_pieces()) build_solvers(basis_);
   setup_.reduced_system = clock.lap();
   if (!options_.single_solve) {
     details_ = std::make_unique<DetailReconstruction>(
@@ -108,6 +94,41 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
     setup_.detail_factorization = clock.lap();
   }
   deformed_base_ = base_;
+}
+
+bool SpectralDeformer::by_moving_pieces() const {
+  return options_.solver == DeformSolver::Spectral && num_components_ > 1 &&
+         options_.constraints == ConstraintMode::Soft;
+}
+
+void SpectralDeformer::build_solvers(std::shared_ptr<const ManifoldHarmonics> basis,
+                                     const std::vector<char>& moving) {
+  const bool spectral = options_.solver == DeformSolver::Spectral;
+  solve_basis_ = std::move(basis);
+  solve_piece_modes_.assign(num_components_, 0);
+  if (solve_basis_ == basis_) {
+    for (const int c : piece_of_mode_) ++solve_piece_modes_[c];
+  } else {
+    for (Eigen::Index j = 0; j < solve_basis_->basis.cols(); ++j) {
+      Eigen::Index i;
+      solve_basis_->basis.col(j).cwiseAbs().maxCoeff(&i);
+      ++solve_piece_modes_[components_[i]];
+    }
+  }
+  if (options_.energy == DeformEnergy::Arap) {
+    arap_ = std::make_unique<ArapSolver>(mesh_, base_, spectral ? solve_basis_ : nullptr,
+                                         options_.arap, moving);
+    clusters_ = arap_->clusters();
+  }
+  if (spectral) {
+    reduced_ = std::make_unique<ReducedSolver>(
+        solve_basis_,
+        arap_ ? arap_->reduced_hessian() : linear_hessian(mesh_, *solve_basis_, options_),
+        piece_area_fractions(lumped_mass(mesh_), components_, num_components_), options_);
+    if (options_.float32_basis) basis32_ = solve_basis_->basis.cast<float>();
+  } else {
+    spatial_ = std::make_unique<SpatialSolver>(mesh_, options_);
+  }
 }
 
 SpectralDeformer::~SpectralDeformer() = default;
@@ -121,8 +142,26 @@ void SpectralDeformer::set_selection(const Selection& selection) {
   std::vector<char> driving(num_components_, 0);
   for (size_t i = 0; i < constrained_.first_free; ++i)
     driving[components_[constrained_.vertices[i]]] = 1;
+  if (by_moving_pieces()) {
+    std::vector<char> moving(num_components_, 0);
+    for (const std::vector<int>& group : selection.handles)
+      for (const int v : group) moving[components_[v]] = 1;
+    if (moving != moving_) {
+      clock.lap();
+      moving_ = moving;
+      if (std::find(moving.begin(), moving.end(), 1) == moving.end()) {
+        build_solvers(basis_);  // no handle vertex: nothing moves, in any basis
+      } else {
+        std::vector<char> vertices(mesh_.num_vertices());
+        for (int v = 0; v < mesh_.num_vertices(); ++v) vertices[v] = moving[components_[v]];
+        build_solvers(detail::moving_basis(mesh_, *basis_, components_, piece_of_mode_, moving_),
+                      vertices);
+      }
+      setup_.reduced_system = clock.lap();
+    }
+  }
   for (int c = 0; c < num_components_; ++c)
-    if (driving[c]) constrained_piece_modes_.push_back(piece_modes_[c]);
+    if (driving[c]) constrained_piece_modes_.push_back(solve_piece_modes_[c]);
   follow_.reset();
   if (constrained_.free_pieces > 0 && options_.unconstrained == UnconstrainedPieces::Follow) {
     follow_ = std::make_unique<detail::FreePieces>(mesh_, components_, driving);
@@ -158,7 +197,7 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
     displacement_targets.row(i) -= base_.row(constrained_.vertices[i]);
   // ARAP starts from the handles' rotations spread over the surface, or from the last frame
   // when asked to.
-  const Eigen::Index size = reduced_ ? basis_->basis.cols() : mesh_.num_vertices();
+  const Eigen::Index size = reduced_ ? solve_basis_->basis.cols() : mesh_.num_vertices();
   const bool warm = options_.arap.warm_start && state_.x.rows() == size;
   arap_report_ = ArapReport{};
   arap_report_.converged = true;
@@ -176,7 +215,7 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
     if (options_.float32_basis) {
       detail::add_basis_product(base_, basis32_, state_.x, deformed_base_);
     } else {
-      detail::add_basis_product(base_, basis_->basis, state_.x, deformed_base_);
+      detail::add_basis_product(base_, solve_basis_->basis, state_.x, deformed_base_);
     }
     frame_.inverse_transform = clock.lap();
   } else {
@@ -212,6 +251,7 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
   if (options_.single_solve) {  // the solvers' memory back before the details take theirs
     clock.lap();
     basis_.reset();
+    solve_basis_.reset();
     basis32_ = Eigen::MatrixXf();
     reduced_.reset();
     spatial_.reset();

@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <queue>
 #include <set>
 
+#include "specdeform/mesh/generate.h"
 #include "specdeform/mesh/mesh_info.h"
 #include "support/corpus.h"
 
@@ -63,6 +66,34 @@ TEST(VertexClusters, CorpusInvariants) {
       EXPECT_EQ(vertex_clusters(m.mesh, requested).label, c.label) << "deterministic";
     }
   }
+}
+
+// Clusters within a region: one sphere of two (642 vertices each) gets min(200, 642 / 16) = 40
+// clusters, each inside it; the other sphere is one cluster, the last. A region of a stray
+// triangle alone is one cluster.
+TEST(VertexClusters, WithinARegion) {
+  TriangleMesh shifted = make_icosphere(3);
+  shifted.V.col(0).array() += 3.0;
+  const TriangleMesh mesh = test::concatenate(make_icosphere(3), shifted);
+  const int n = mesh.num_vertices(), half = n / 2;
+  std::vector<char> region(n, 0);
+  std::fill(region.begin(), region.begin() + half, 1);
+  const VertexClusters c = vertex_clusters(mesh, 200, region);
+  EXPECT_EQ(c.count, 41);
+  for (int v = 0; v < half; ++v) EXPECT_LT(c.label[v], 40);
+  for (int v = half; v < n; ++v) EXPECT_EQ(c.label[v], 40);
+  for (int k = 0; k < 40; ++k)
+    EXPECT_NE(std::find(c.label.begin(), c.label.end(), k), c.label.end());
+  TriangleMesh stray{Vertices(3, 3), Faces(1, 3)};
+  stray.V << 5, 0, 0, 5.1, 0, 0, 5, 0.1, 0;
+  stray.F << 0, 1, 2;
+  const TriangleMesh with_stray = test::concatenate(mesh, stray);
+  std::vector<char> speck(with_stray.num_vertices(), 0);
+  std::fill(speck.end() - 3, speck.end(), 1);
+  const VertexClusters one = vertex_clusters(with_stray, 200, speck);
+  EXPECT_EQ(one.count, 2);
+  EXPECT_EQ(one.label.tail(3), Eigen::Vector3i::Zero());
+  EXPECT_EQ(one.label.head(n), Eigen::VectorXi::Ones(n));
 }
 
 }  // namespace

@@ -78,9 +78,12 @@ struct ArapState {
 class ArapSolver {
  public:
   // mesh: the detailed mesh (its Laplacian's weights); base: its smooth base s (n x 3); basis:
-  // the manifold harmonics (the spectral subspace) or null (all vertices).
+  // the manifold harmonics (the spectral subspace) or null (all vertices); moving: the vertices
+  // the basis can move (n flags, whole pieces; empty: all): the clusters cover them, the others
+  // are one more cluster, which stays unturned.
   ArapSolver(const TriangleMesh& mesh, const Vertices& base,
-             std::shared_ptr<const ManifoldHarmonics> basis, const ArapOptions& options);
+             std::shared_ptr<const ManifoldHarmonics> basis, const ArapOptions& options,
+             const std::vector<char>& moving = {});
 
   // The cold start of a frame: the rotation of each handle group (the polar part of its
   // transform) spread over the surface, R_k = exp(sum_g phi_g,k log R_g) with phi_g the harmonic

@@ -113,8 +113,10 @@ class SpectralDeformer {
   // Connected components without a constrained vertex in the last selection (they follow the
   // surface or are held in place, as options().unconstrained says).
   int free_pieces() const { return constrained_.free_pieces; }
-  // The basis's modes on each piece that has a constrained vertex in the last selection, in
-  // the order of the pieces' first vertices (one entry, all the modes, for a mesh of one piece).
+  // The modes the solve deforms each piece that has a constrained vertex in the last selection
+  // with, in the order of the pieces' first vertices (one entry, all the modes, for a mesh of one
+  // piece; on several pieces under soft constraints, 0 for a piece held by fixed vertices alone,
+  // and m split among the pieces with a handle: deform/moving_basis.h).
   const std::vector<int>& constrained_piece_modes() const { return constrained_piece_modes_; }
 
   // options().background_transfer (DetailReconstruction's background): whether the transfer's
@@ -134,8 +136,17 @@ class SpectralDeformer {
   int detail_fold_zone() const { return details_ ? details_->fold_zone() : 0; }
 
  private:
+  bool by_moving_pieces() const;
+  // The solvers in `basis`; ARAP's clusters on the `moving` vertices (n flags; empty: all).
+  void build_solvers(std::shared_ptr<const ManifoldHarmonics> basis,
+                     const std::vector<char>& moving = {});
+
   TriangleMesh mesh_;
   std::shared_ptr<const ManifoldHarmonics> basis_;
+  // The basis the spectral solvers work in: basis_, or on several pieces under soft
+  // constraints the modes of the pieces with a handle (deform/moving_basis.h), for moving_.
+  std::shared_ptr<const ManifoldHarmonics> solve_basis_;
+  std::vector<char> moving_;
   DeformOptions options_;
   Eigen::MatrixXf basis32_;  // float32_basis: the basis in single precision
   Vertices base_, deformed_base_;
@@ -146,8 +157,9 @@ class SpectralDeformer {
   std::unique_ptr<detail::FreePieces> follow_;     // Follow: the free pieces of the selection
   Eigen::VectorXi components_;                     // connected component of each vertex
   int num_components_ = 0;
-  int clusters_ = 0;              // ARAP's rotation clusters
-  std::vector<int> piece_modes_;  // the basis's modes on each connected component
+  int clusters_ = 0;                    // ARAP's rotation clusters
+  std::vector<int> piece_of_mode_;      // the component of each of the basis's columns
+  std::vector<int> solve_piece_modes_;  // solve_basis_'s modes on each component
   std::vector<int> constrained_piece_modes_;
   ConstrainedSet constrained_;
   ArapState state_;                  // c (spectral) or d (spatial) of the last solve, and

@@ -9,6 +9,8 @@
 // Deterministic; O(n log n) (2.77M vertices, 200 clusters: 1.5 s).
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "specdeform/mesh/triangle_mesh.h"
@@ -21,5 +23,11 @@ struct VertexClusters {
 };
 
 VertexClusters vertex_clusters(const TriangleMesh& mesh, int count);
+
+// The same within a region (`region[v]`, n flags, whole connected components): `count`
+// clusters (at most one per 16 of its vertices, at least one per component) cover the region;
+// the vertices outside it form one more cluster, the last (none when the region is everything).
+VertexClusters vertex_clusters(const TriangleMesh& mesh, int count,
+                               const std::vector<char>& region);
 
 }  // namespace specdeform
