@@ -205,6 +205,19 @@ def check_edit_mode():
           f"(before the edit {before:.3f})")
     assert abs(bump - 0.5) <= 0.05, bump
 
+    # Vertices added (an edge of the free vertex split): bound again on the new mesh, posed.
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.context.view_layer.update()
+    bm = bmesh.from_edit_mesh(obj.data)
+    bm.verts.ensure_lookup_table()
+    bmesh.ops.subdivide_edges(bm, edges=bm.verts[free].link_edges[:1], cuts=1)
+    bmesh.update_edit_mesh(obj.data)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    bpy.context.view_layer.update()
+    assert len(support.binding.binding(obj).rest) == len(rest) + 1
+    moved = support.evaluated(obj)[: len(rest)]
+    assert np.abs(moved - X).max() <= 0.01 * support.diagonal(rest), "the pose was not applied"
+
 
 def check_handles():
     """Two handles, two Empties: both reached; then one handle of weight 0.5 moves half way."""
