@@ -127,7 +127,7 @@ class SPECDEFORM_OT_bake_pose(bpy.types.Operator):
     """Keep the current pose as a shape key (on) over the rest shape, and unbind"""
 
     bl_idname = "specdeform.bake_pose"
-    bl_label = "Pose to Shape Key"
+    bl_label = "Bake Pose"
     bl_options = {"REGISTER", "UNDO"}
 
     @classmethod
