@@ -159,7 +159,7 @@ np.save(r'{out}', co.reshape(-1, 3))
 
 def check_bakes(obj, path, direct, diagonal, workdir):
     """Bakes of frames 1-20 to a point cache and to shape keys, played at frame 20 by a Blender
-    without the add-on."""
+    without the add-on, and frame 20's pose baked to one shape key."""
     played = {}
     for kind in ("POINT_CACHE", "SHAPE_KEYS"):
         bpy.ops.wm.open_mainfile(filepath=path)  # bound again by the load handler
@@ -174,6 +174,15 @@ def check_bakes(obj, path, direct, diagonal, workdir):
         miss = np.abs(played[kind] - direct).max() / diagonal
         print(f"bake {kind} played without the add-on: frame 20 vs direct {miss:.1e}")
         assert miss <= 1e-4, miss
+
+    # The pose of frame 20 kept as one shape key, on, over the rest; the mesh unbound.
+    bpy.ops.wm.open_mainfile(filepath=path)
+    bpy.context.scene.frame_set(20)
+    assert bpy.ops.specdeform.bake_pose() == {"FINISHED"}
+    obj = bpy.data.objects["bar"]
+    bpy.context.scene.frame_set(1)
+    assert not obj.specdeform.bound and obj.data.shape_keys.key_blocks[1].value == 1.0
+    assert np.abs(support.evaluated(obj) - direct).max() <= 1e-4 * diagonal
 
 
 def check_edit_mode():
