@@ -134,11 +134,12 @@ def request(obj):
     F = mesh_helpers.triangles(mesh)
     if len(F) == 0:
         return "the mesh has no faces"
-    used, F = np.unique(F, return_inverse=True)  # loose vertices stay where they are
+    used = np.flatnonzero(np.bincount(F.ravel(), minlength=len(rest)))  # loose ones stay put
     if s.modes > len(used):
         return f"Modes is {s.modes}, more than the mesh's {len(used)} vertices: lower Modes"
     renumber = np.full(len(rest), -1, np.int64)
     renumber[used] = np.arange(len(used))
+    F = renumber[F]
     names = [group for group, _, _ in handles(obj)] + [s.fixed_group] * bool(s.fixed_group)
     weights = mesh_helpers.group_weights(obj, set(names))
     members = {}
@@ -152,7 +153,7 @@ def request(obj):
         return "a vertex is in two of the groups (handles, fixed): each vertex follows one"
     split = [x for h, (group, _, _) in enumerate(handles(obj)) for x in _levels(h, *members[group])]
     fixed = members[s.fixed_group][0] if s.fixed_group else np.empty(0, np.int64)
-    return Request(rest, used, rest[used].astype(np.float64), F.reshape(-1, 3).astype(np.int32),
+    return Request(rest, used, rest[used].astype(np.float64), F.astype(np.int32),
                    [g for g, _ in split], [level for _, level in split], fixed, s.modes,
                    s.eigensolver)
 
