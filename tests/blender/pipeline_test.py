@@ -229,7 +229,8 @@ def check_edit_mode():
 
 
 def check_handles():
-    """Two handles, two Empties: both reached; then one handle of weight 0.5 moves half way."""
+    """Two handles, two Empties: both reached, also when a driver moves one; then one handle of
+    weight 0.5 moves half way."""
     V, F = specdeform.bumpy_bar(cells_per_unit=8)
     ends = np.flatnonzero(V[:, 0] > 3.6), np.flatnonzero(V[:, 0] < 0.4)
     middle = np.flatnonzero(np.abs(V[:, 0] - 2) < 0.2)
@@ -251,6 +252,18 @@ def check_handles():
               for g, T in zip(ends, (up, down))]
     print(f"two handles: misses {misses[0]:.1e}, {misses[1]:.1e} of the diagonal")
     assert max(misses) <= 0.005, misses
+
+    # A driver moves the second Empty with the frame: frame_set poses it.
+    support.move(second, np.eye(4))
+    fcurve = second.driver_add("location", 2)
+    fcurve.driver.expression = "frame / 40"
+    bpy.context.scene.frame_set(20)
+    X = support.evaluated(obj)
+    down[:3, 3] = (0, 0, 0.5)
+    miss = np.linalg.norm(X[ends[1]] - support.apply_transform(down, rest[ends[1]]), axis=1).max()
+    print(f"driver: miss {miss / diagonal:.1e} of the diagonal")
+    assert miss <= 0.005 * diagonal, miss / diagonal
+    second.driver_remove("location", 2)
 
     assert bpy.ops.specdeform.unbind() == {"FINISHED"}
     obj.vertex_groups["handle"].add([int(i) for i in ends[0]], 0.5, "REPLACE")
