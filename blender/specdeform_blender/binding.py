@@ -121,6 +121,17 @@ def _levels(h, indices, weights):
     return [(indices[rounded == w], (h, float(w))) for w in np.unique(rounded)]
 
 
+def _shared(names, members):
+    """Two of the groups (handles, fixed) that share vertices, said in one line, or None."""
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            if a == b:
+                return f"vertex group '{a}' is used twice: each vertex follows one handle"
+            if np.intersect1d(members[a][0], members[b][0]).size:
+                return f"vertex groups '{a}' and '{b}' share vertices: each follows one handle"
+    return None
+
+
 def request(obj):
     """Bind's input from `obj` (its saved rest when it is bound already), or an error message."""
     s = obj.specdeform
@@ -148,9 +159,9 @@ def request(obj):
         if not keep.any():
             return f"vertex group '{name}' holds no vertex of a face"
         members[name] = (renumber[indices][keep], w[keep])
-    taken = np.concatenate([members[name][0] for name in names])
-    if len(np.unique(taken)) < len(taken):
-        return "a vertex is in two of the groups (handles, fixed): each vertex follows one"
+    problem = _shared(names, members)
+    if problem:
+        return problem
     split = [x for h, (group, _, _) in enumerate(handles(obj)) for x in _levels(h, *members[group])]
     fixed = members[s.fixed_group][0] if s.fixed_group else np.empty(0, np.int64)
     return Request(rest, used, rest[used].astype(np.float64), F.astype(np.int32),

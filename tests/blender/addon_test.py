@@ -146,6 +146,12 @@ def check_refusals(obj):
     expect_refusal(obj, "vertex group 'empty' holds no vertex")
     s.handle_group, s.fixed_group = "handle", "missing"
     expect_refusal(obj, "no vertex group 'missing'")
+    s.fixed_group = "handle"
+    expect_refusal(obj, "vertex group 'handle' is used twice")
+    first = int(support.mesh_helpers.group_weights(obj, ["handle"])["handle"][0][0])
+    obj.vertex_groups.new(name="overlap").add([first], 1.0, "REPLACE")
+    s.fixed_group = "overlap"
+    expect_refusal(obj, "vertex groups 'handle' and 'overlap' share vertices")
     target, s.fixed_group, s.target = s.target, "fixed", None
     expect_refusal(obj, "choose a target")
     s.target = target
