@@ -19,9 +19,8 @@ class SPECDEFORM_OT_bind(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        obj = context.object
-        return (_poll_mesh(context) and context.mode == "OBJECT"
-                and binding.binding(obj) is None)
+        ready = _poll_mesh(context) and context.mode == "OBJECT"
+        return ready and binding.binding(context.object) is None  # greyed out while bound
 
     def execute(self, context):
         return self._done(binding.bind_now(context.object))
