@@ -34,7 +34,8 @@ problems = {}  # Object.name_full -> why a bound object has no binding (one line
 
 
 def binding(obj):
-    return _bindings.get(obj.name_full)
+    """The object's binding while its settings say bound (undo past Bind leaves one in memory)."""
+    return _bindings.get(obj.name_full) if obj.specdeform.bound else None
 
 
 def forget_all():
