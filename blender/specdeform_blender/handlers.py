@@ -47,12 +47,25 @@ def _follow(obj, b, depsgraph):
 
 @bpy.app.handlers.persistent
 def follow_targets(scene, depsgraph):
-    """depsgraph_update_post and frame_change_post: each bound mesh of the scene follows."""
+    """depsgraph_update_post and frame_change_post: each bound mesh of the scene follows; one
+    bound without a binding (renamed, or Unbind undone) is bound again first."""
     for obj in scene.objects:
-        if obj.type == "MESH" and obj.specdeform.bound:
+        if obj.type == "MESH" and obj.specdeform.bound and library.specdeform is not None:
+            if binding.binding(obj) is None and obj.name_full not in binding.problems:
+                _bind_again(obj)
             b = binding.binding(obj)
             if b is not None:
                 _follow(obj, b, depsgraph)
+
+
+def _bind_again(obj):
+    """Binds a bound object from its saved rest, its progress printed; a failure is kept (and
+    said in the panel) so that it is not tried on every update."""
+    name = obj.name
+    error = binding.bind_now(obj, lambda text: print(f"specdeform: '{name}': {text}"))
+    if error:
+        binding.problems[obj.name_full] = error
+        print(f"specdeform: '{name}' stays as saved: {error}")
 
 
 @bpy.app.handlers.persistent
@@ -64,8 +77,4 @@ def bind_loaded(*_):
         return
     for obj in bpy.data.objects:
         if obj.type == "MESH" and obj.specdeform.bound:
-            name = obj.name
-            error = binding.bind_now(obj, lambda text: print(f"specdeform: '{name}': {text}"))
-            if error:
-                binding.problems[obj.name_full] = error
-                print(f"specdeform: '{obj.name}' stays as saved: {error}")
+            _bind_again(obj)

@@ -109,6 +109,12 @@ def check_deform(name, V, F, handle, fixed, T, min_ring, workdir):
     assert np.abs(support.evaluated(obj) - X).max() <= 1e-5 * diagonal
     empty = obj.specdeform.target
 
+    # Renamed: bound again from the saved input at the next update, posed as before.
+    obj.name = name + " renamed"
+    support.move(empty, np.array(empty.matrix_world))
+    assert support.binding.binding(obj) is not None
+    assert np.abs(support.evaluated(obj) - X).max() <= 1e-5 * diagonal
+
     assert bpy.ops.specdeform.unbind() == {"FINISHED"}
     assert not obj.specdeform.bound
     assert np.abs(support.evaluated(obj) - rest).max() <= 1e-6 * diagonal, "unbind lost the input"
