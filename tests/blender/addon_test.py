@@ -213,6 +213,7 @@ def check_loose_parts():
         obj.specdeform.unconstrained = mode
         support.bind(obj)
         line = support.panel_lines(obj)[0]
+        print(line)
         assert line.endswith("100 asked, more as each of 2 loose parts gets its own"), line
         support.move(empty, T)
         X = support.evaluated(obj)
