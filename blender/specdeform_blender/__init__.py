@@ -2,8 +2,9 @@
 
 A thin adapter over the compiled `specdeform` module: Bind computes (or loads from the cache the
 CLI and the editor share) the mesh's manifold harmonics and a deformer; while bound, moving the
-target deforms the mesh through a depsgraph handler; Unbind restores the input; Apply keeps the
-result. See docs/blender.md.
+targets deforms the mesh through depsgraph and frame handlers, a loaded file is bound again by a
+load handler, Edit Mode edits the rest shape; Unbind restores the input; Apply keeps the result;
+Bake writes shape keys or a point cache. See docs/blender.md.
 """
 
 bl_info = {
@@ -18,14 +19,25 @@ bl_info = {
 
 import bpy
 
-from . import operators, properties, ui
+from . import bake, binding, handlers, operators, properties, ui
 
 classes = (
+    properties.SpecdeformHandle,
     properties.SpecdeformSettings,
     operators.SPECDEFORM_OT_bind,
     operators.SPECDEFORM_OT_unbind,
     operators.SPECDEFORM_OT_apply,
+    operators.SPECDEFORM_OT_handle_add,
+    operators.SPECDEFORM_OT_handle_remove,
+    bake.SPECDEFORM_OT_bake,
+    bake.SPECDEFORM_OT_bake_pose,
+    ui.SPECDEFORM_UL_handles,
     ui.VIEW3D_PT_specdeform,
+)
+_handlers = (
+    (bpy.app.handlers.depsgraph_update_post, handlers.follow_targets),
+    (bpy.app.handlers.frame_change_post, handlers.follow_targets),
+    (bpy.app.handlers.load_post, handlers.bind_loaded),
 )
 
 
@@ -33,14 +45,14 @@ def register():
     for cls in classes:
         bpy.utils.register_class(cls)
     bpy.types.Object.specdeform = bpy.props.PointerProperty(type=properties.SpecdeformSettings)
-    bpy.app.handlers.depsgraph_update_post.append(operators.follow_targets)
-    bpy.app.handlers.load_post.append(operators.forget_bindings)
+    for handler_list, handler in _handlers:
+        handler_list.append(handler)
 
 
 def unregister():
-    bpy.app.handlers.load_post.remove(operators.forget_bindings)
-    bpy.app.handlers.depsgraph_update_post.remove(operators.follow_targets)
-    operators.forget_bindings()
+    for handler_list, handler in _handlers:
+        handler_list.remove(handler)
+    binding.forget_all()
     del bpy.types.Object.specdeform
     for cls in reversed(classes):
         bpy.utils.unregister_class(cls)

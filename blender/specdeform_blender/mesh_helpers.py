@@ -24,14 +24,17 @@ def triangles(mesh):
     return tris.reshape(-1, 3)
 
 
-def group_members(obj, name):
-    """Indices of the vertices in vertex group `name` with a weight above 0 (a loop over the
-    vertices, at Bind only: Blender 3.4 has no bulk access to vertex group weights)."""
-    index = obj.vertex_groups[name].index
-    return np.array(
-        [v.index for v in obj.data.vertices for g in v.groups if g.group == index and g.weight > 0],
-        np.int64,
-    )
+def group_weights(obj, names):
+    """{name: (vertex indices, weights)} of the vertex groups `names`, weights above 0 (one loop
+    over the vertices, at Bind only: Blender 3.4 has no bulk access to vertex group weights)."""
+    index = {obj.vertex_groups[name].index: name for name in names}
+    found = {name: ([], []) for name in names}
+    for v in obj.data.vertices:
+        for g in v.groups:
+            if g.group in index and g.weight > 0:
+                found[index[g.group]][0].append(v.index)
+                found[index[g.group]][1].append(g.weight)
+    return {name: (np.array(i, np.int64), np.array(w)) for name, (i, w) in found.items()}
 
 
 def save_rest(mesh, co):

@@ -3,6 +3,7 @@
 import bpy
 from bpy.props import (
     BoolProperty,
+    CollectionProperty,
     EnumProperty,
     FloatProperty,
     FloatVectorProperty,
@@ -12,19 +13,42 @@ from bpy.props import (
 )
 
 
+def _bound_matrix():
+    return FloatVectorProperty(
+        name="Object in target",
+        size=16,
+        description="The object's matrix in its target's space when bound",
+    )
+
+
+class SpecdeformHandle(bpy.types.PropertyGroup):
+    """A further handle: a vertex group and the object that moves it."""
+
+    group: StringProperty(name="Group", description="Vertex group moved by the target")
+    target: PointerProperty(
+        name="Target",
+        type=bpy.types.Object,
+        description="Object (normally an Empty) whose transform since binding moves the group",
+    )
+    bound_matrix: _bound_matrix()
+
+
 class SpecdeformSettings(bpy.types.PropertyGroup):
-    # One handle group and its target now; several, each with its own target, will be a
-    # collection of (group, target) pairs: the binding already keeps lists of both.
+    # The first handle (handle_group, target) and any further ones (handles): each is a handle
+    # group of the library's scene, its vertex weights blending rest and target as a Hook does.
     handle_group: StringProperty(
         name="Handle", description="Vertex group moved by the target"
-    )
-    fixed_group: StringProperty(
-        name="Fixed", description="Vertex group that stays in place (optional)"
     )
     target: PointerProperty(
         name="Target",
         type=bpy.types.Object,
         description="Object (normally an Empty) whose transform since binding moves the handle",
+    )
+    bound_matrix: _bound_matrix()
+    handles: CollectionProperty(type=SpecdeformHandle, name="More handles")
+    handle_index: IntProperty(name="Active handle", default=0)
+    fixed_group: StringProperty(
+        name="Fixed", description="Vertex group that stays in place (optional)"
     )
     modes: IntProperty(
         name="Modes",
@@ -32,6 +56,16 @@ class SpecdeformSettings(bpy.types.PropertyGroup):
         default=100,
         min=1,
         max=5000,
+    )
+    eigensolver: EnumProperty(
+        name="Basis",
+        description="How the harmonics are computed",
+        items=(
+            ("auto", "Automatic", "Exact below 200,000 vertices, multilevel from there"),
+            ("krylov", "Exact", "The exact harmonics (slow on very large meshes)"),
+            ("multilevel", "Multilevel", "An approximation for large meshes, several times faster"),
+        ),
+        default="auto",
     )
     energy: EnumProperty(
         name="Energy",
@@ -67,8 +101,3 @@ class SpecdeformSettings(bpy.types.PropertyGroup):
         min=1e-6,
     )
     bound: BoolProperty(name="Bound", description="The mesh follows the target", default=False)
-    bound_matrix: FloatVectorProperty(
-        name="Object in target",
-        size=16,
-        description="The object's matrix in its target's space when bound",
-    )

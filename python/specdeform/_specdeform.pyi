@@ -129,6 +129,10 @@ class Harmonics:
     @property
     def cluster_truncated(self) -> bool: ...
     @property
+    def pieces(self) -> int: ...
+    @property
+    def requested_modes(self) -> int: ...
+    @property
     def bands(self) -> int: ...
     @property
     def restarts(self) -> int: ...
@@ -143,7 +147,7 @@ def manifold_harmonics(
     mass: _Mass = "lumped",
     cache: _Path | None = None,
     tolerance: float = 1e-8,
-    eigensolver: Literal["krylov", "lanczos", "multilevel"] = "krylov",
+    eigensolver: Literal["krylov", "lanczos", "multilevel", "auto"] = "krylov",
     progress: _Progress | None = None,
     seed: int = 1,
 ) -> tuple[_Float, _Float]: ...

@@ -107,6 +107,13 @@ returns (evecs.base). SpectralDeformer shares it without a copy.)")
                              [](const Harmonics& h) { return h.value->max_orthogonality_error; })
       .def_property_readonly("cluster_truncated",
                              [](const Harmonics& h) { return h.value->cluster_truncated; })
+      .def_property_readonly(
+          "pieces", [](const Harmonics& h) { return h.value->pieces; },
+          "Connected pieces, each given its own modes (0: not recorded).")
+      .def_property_readonly(
+          "requested_modes", [](const Harmonics& h) { return h.value->requested_modes; },
+          "The modes asked for: fewer than the basis holds when several pieces each got their "
+          "floor (spectral/piecewise.h).")
       .def_property_readonly("bands", [](const Harmonics& h) { return h.value->bands; })
       .def_property_readonly("restarts", [](const Harmonics& h) { return h.value->restarts; })
       .def_property_readonly("solves", [](const Harmonics& h) { return h.value->solves; })
@@ -126,9 +133,11 @@ returns (evecs.base). SpectralDeformer shares it without a copy.)")
         o.num_modes = k;
         o.mass = mass_from_name(mass);
         o.tolerance = tolerance;
-        o.solver = eigen_solver_from_name(eigensolver);
+        const TriangleMesh mesh = to_mesh(V, F);
+        o.solver = eigensolver == "auto" ? default_eigensolver(mesh.num_vertices(), o.policy)
+                                         : eigen_solver_from_name(eigensolver);
         o.seed = seed;
-        return eigenpairs(obtain_basis(to_mesh(V, F), o, cache, progress));
+        return eigenpairs(obtain_basis(mesh, o, cache, progress));
       },
       py::arg("V"), py::arg("F"), py::arg("k"), py::kw_only(), py::arg("mass") = "lumped",
       py::arg("cache") = py::none(), py::arg("tolerance") = defaults.tolerance,
@@ -145,9 +154,10 @@ written otherwise (the CLI's --basis), or an existing directory of bases named a
 names them (its cache is ~/.cache/specdeform). tolerance: the residual each pair must reach, on
 the mesh scaled to unit area. progress: called as progress(fraction, stage); an exception it
 raises, or Ctrl-C, aborts the computation. The GIL is released while it runs.
-eigensolver: "krylov" (exact, the default), "lanczos" (Spectra, the baseline) or "multilevel"
+eigensolver: "krylov" (exact, the default), "lanczos" (Spectra, the baseline), "multilevel"
 (an approximation for large meshes: M-orthonormal, not eigenvectors; Harmonics.approximate
-and .residuals say so; its cache file is kept apart from the exact one's).
+and .residuals say so; its cache file is kept apart from the exact one's) or "auto" (the command
+line's and the editor's choice: multilevel from 200,000 vertices, krylov below).
 Raises SolverError if the eigensolver does not converge.)");
 
   m.def(

@@ -71,17 +71,11 @@ def cli_deform(V, F, handle, fixed, T, workdir):
     return specdeform.read_mesh(out)[0]
 
 
-def bind(obj):
-    bpy.context.view_layer.objects.active = obj
-    assert bpy.ops.specdeform.bind() == {"FINISHED"}
-    assert obj.specdeform.bound
-
-
 def check_deform(name, V, F, handle, fixed, T, min_ring, workdir):
     obj, empty = support.add_object(name, V, F, handle, fixed)
     rest = support.evaluated(obj)
     diagonal = support.diagonal(rest)
-    bind(obj)
+    support.bind(obj)
     assert np.array_equal(support.evaluated(obj), rest), "binding moved the mesh"
     support.move(empty, T)
     X = support.evaluated(obj)
@@ -104,16 +98,22 @@ def check_deform(name, V, F, handle, fixed, T, min_ring, workdir):
     support.move(empty, R @ T)
     assert np.abs(support.evaluated(obj) - X).max() <= 1e-5 * diagonal
 
-    # Saved and reopened: still bound, the binding asked for again, resumed from the saved input.
+    # Saved and reopened: bound again from the saved input by the load handler, no Bind pressed
+    # (Bind is greyed out while bound).
     path = os.path.join(workdir, "bound.blend")
     bpy.ops.wm.save_as_mainfile(filepath=path)
     bpy.ops.wm.open_mainfile(filepath=path)
     obj = bpy.data.objects[name]
-    assert obj.specdeform.bound and support.operators.binding(obj) is None
-    assert support.panel_lines(obj) == ["Bound in the file: press Bind to resume"]
-    bind(obj)
+    assert obj.specdeform.bound and support.binding.binding(obj) is not None
+    assert not bpy.ops.specdeform.bind.poll()
     assert np.abs(support.evaluated(obj) - X).max() <= 1e-5 * diagonal
     empty = obj.specdeform.target
+
+    # Renamed: bound again from the saved input at the next update, posed as before.
+    obj.name = name + " renamed"
+    support.move(empty, np.array(empty.matrix_world))
+    assert support.binding.binding(obj) is not None
+    assert np.abs(support.evaluated(obj) - X).max() <= 1e-5 * diagonal
 
     assert bpy.ops.specdeform.unbind() == {"FINISHED"}
     assert not obj.specdeform.bound
@@ -124,7 +124,7 @@ def check_deform(name, V, F, handle, fixed, T, min_ring, workdir):
 
     # Apply keeps the deformation as the mesh's own and stops following.
     obj.matrix_world = support.Matrix(np.eye(4).tolist())
-    bind(obj)
+    support.bind(obj)
     support.move(empty, T)
     assert bpy.ops.specdeform.apply() == {"FINISHED"}
     support.move(empty, np.eye(4))
@@ -152,6 +152,12 @@ def check_refusals(obj):
     expect_refusal(obj, "vertex group 'empty' holds no vertex")
     s.handle_group, s.fixed_group = "handle", "missing"
     expect_refusal(obj, "no vertex group 'missing'")
+    s.fixed_group = "handle"
+    expect_refusal(obj, "vertex group 'handle' is used twice")
+    first = int(support.mesh_helpers.group_weights(obj, ["handle"])["handle"][0][0])
+    obj.vertex_groups.new(name="overlap").add([first], 1.0, "REPLACE")
+    s.fixed_group = "overlap"
+    expect_refusal(obj, "vertex groups 'handle' and 'overlap' share vertices")
     target, s.fixed_group, s.target = s.target, "fixed", None
     expect_refusal(obj, "choose a target")
     s.target = target
@@ -160,7 +166,7 @@ def check_refusals(obj):
 def check_cancel(obj):
     """The panel's Bind computes the basis on a worker thread that Esc cancels."""
     obj.specdeform.modes = 60  # not in the cache
-    job = support.operators.BasisJob(support.operators._request(obj))
+    job = support.binding.BasisJob(support.binding.request(obj))
     job.cancel()
     assert job.join().error == "cancelled" and job.result is None, job.error
     assert not any("-m60-" in f for f in os.listdir(support.library.cache_dir()))
@@ -176,7 +182,10 @@ def check_polygons():
     grid.loops.foreach_get("vertex_index", quads)
     handle, fixed = np.flatnonzero(co[:, 0] > 0.8), np.flatnonzero(co[:, 0] < -0.8)
     obj, empty = support.add_object("quads", co, quads.reshape(-1, 4), handle, fixed)
-    bind(obj)
+    obj.specdeform.modes = 1000
+    expect_refusal(obj, "Modes is 1000, more than the mesh's 961 vertices: lower Modes")
+    obj.specdeform.modes = 100
+    support.bind(obj)
     T = np.eye(4)
     T[:3, 3] = (0, 0, 0.3)
     support.move(empty, T)
@@ -202,7 +211,10 @@ def check_loose_parts():
     moved = {}
     for mode in ("follow", "keep"):
         obj.specdeform.unconstrained = mode
-        bind(obj)
+        support.bind(obj)
+        line = support.panel_lines(obj)[0]
+        print(line)
+        assert line.endswith("100 asked, more as each of 2 loose parts gets its own"), line
         support.move(empty, T)
         X = support.evaluated(obj)
         d, d0 = X[ring] - X[len(Vb)], rest[ring] - rest[len(Vb)]

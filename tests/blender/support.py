@@ -13,7 +13,7 @@ import numpy as np  # noqa: E402
 from mathutils import Matrix  # noqa: E402
 
 import specdeform_blender  # noqa: E402
-from specdeform_blender import library, mesh_helpers, operators  # noqa: E402, F401 (for the tests)
+from specdeform_blender import binding, library, mesh_helpers  # noqa: E402, F401 (for the tests)
 
 SKIP = 77  # CTest's SKIP_RETURN_CODE
 
@@ -51,6 +51,12 @@ def add_object(name, V, F, handle, fixed):
     s = obj.specdeform
     s.handle_group, s.fixed_group, s.target = "handle", "fixed", empty
     return obj, empty
+
+
+def bind(obj):
+    bpy.context.view_layer.objects.active = obj
+    assert bpy.ops.specdeform.bind() == {"FINISHED"}
+    assert obj.specdeform.bound
 
 
 def move(empty, T):
@@ -103,7 +109,7 @@ class Layout:
     def prop(self, *_, **__):
         pass
 
-    prop_search = operator = prop
+    prop_search = operator = template_list = prop
 
 
 def panel_lines(obj):

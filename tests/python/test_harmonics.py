@@ -280,3 +280,21 @@ def test_multilevel_basis_is_orthonormal_and_cached_apart(tmp_path):
     assert sorted(p.name.endswith("-multilevel.sdbasis") for p in tmp_path.iterdir()) == [False, True]
     again, _ = specdeform.manifold_harmonics(V, F, 16, eigensolver="multilevel", cache=tmp_path)
     np.testing.assert_array_equal(again, evals)
+
+
+def test_auto_eigensolver_is_the_command_lines_choice():
+    # "auto": krylov below 200,000 vertices (multilevel from there, as the CLI and the editor).
+    V, F = specdeform.icosphere(3)
+    evals, evecs = specdeform.manifold_harmonics(V, F, 8, eigensolver="auto")
+    exact, _ = specdeform.manifold_harmonics(V, F, 8, eigensolver="krylov")
+    assert not evecs.base.approximate
+    np.testing.assert_array_equal(evals, exact)
+
+
+def test_pieces_each_get_their_modes():
+    # Two loose spheres at 10 modes: each piece gets its floor (16), so the basis holds 32.
+    V, F = specdeform.icosphere(2)
+    V2, F2 = np.vstack([V, V + 3]), np.vstack([F, F + len(V)])
+    evals, evecs = specdeform.manifold_harmonics(V2, F2, 10)
+    h = evecs.base
+    assert (h.pieces, h.requested_modes, len(evals)) == (2, 10, 32)

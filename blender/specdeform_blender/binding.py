@@ -1,0 +1,299 @@
+"""A bound object: Bind's input read from the object (Request), its basis computed or loaded on a
+worker thread (BasisJob), the deformer made from both (bind), and the mesh following its targets
+(update)."""
+
+import os
+import threading
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from mathutils import Matrix
+
+from . import library, mesh_helpers
+
+WEIGHT_STEP = 0.01  # handle weights are rounded to this: each level is one group of the scene
+
+
+@dataclass
+class Binding:
+    """What a bound object keeps in memory (remade from the file by the load handler)."""
+
+    deformer: object
+    rest: np.ndarray  # float32 (n, 3): the input, every vertex
+    used: object  # the vertices the faces use, in the deformer's numbering (or all: a slice)
+    levels: list  # (handle, weight) of each of the deformer's handle groups
+    positions: np.ndarray = None  # float32 (n, 3): what is written into the mesh
+    last: np.ndarray = None  # the transforms last solved for
+    editing: bool = False  # in Edit Mode: the mesh shows its rest shape
+    status: dict = field(default_factory=dict)
+
+
+_bindings = {}  # Object.name_full -> Binding (a renamed object is bound again from the file)
+problems = {}  # Object.name_full -> why a bound object has no binding (one line)
+
+
+def binding(obj):
+    """The object's binding while its settings say bound (undo past Bind leaves one in memory)."""
+    return _bindings.get(obj.name_full) if obj.specdeform.bound else None
+
+
+def forget_all():
+    _bindings.clear()
+    problems.clear()
+
+
+def handles(obj):
+    """(vertex group, target, owner of bound_matrix) of each handle: the first is the settings'
+    own handle_group and target, then the list's (read each time: undo replaces the objects)."""
+    s = obj.specdeform
+    return [(s.handle_group, s.target, s)] + [(h.group, h.target, h) for h in s.handles]
+
+
+def local_transforms(obj, depsgraph=None):
+    """Each target's transform since binding, in the object's local space: moving the object
+    and its targets together leaves the mesh as it is (as a Hook modifier does). With a
+    depsgraph, the matrices it evaluated (a render's at its frame)."""
+    seen = (lambda o: o.evaluated_get(depsgraph)) if depsgraph else (lambda o: o)
+    to_local = seen(obj).matrix_world.inverted()
+    return np.array(
+        [
+            to_local @ seen(t).matrix_world @ Matrix(np.reshape(m.bound_matrix, (4, 4)).tolist())
+            for _, t, m in handles(obj)
+        ]
+    )
+
+
+def blend(transforms, levels):
+    """Hook's weights: weight w takes a vertex to rest + w (T rest - rest), ((1-w) I + w T) rest."""
+    return [(1 - w) * np.eye(4) + w * transforms[h] for h, w in levels]
+
+
+def update(obj, b, depsgraph=None):
+    """Solves for the targets' transforms and writes the positions, unless they did not move."""
+    transforms = local_transforms(obj, depsgraph)
+    if b.last is not None and np.array_equal(transforms, b.last):
+        return
+    start = time.perf_counter()
+    X = b.deformer.solve(blend(transforms, b.levels))
+    solved = time.perf_counter()
+    b.last = transforms  # before writing: the write triggers the depsgraph handler again
+    b.positions[b.used] = X
+    mesh_helpers.set_coordinates(obj.data, b.positions)
+    b.status.pop("error", None)
+    b.status["iterations"] = b.deformer.report.get("iterations", 0)
+    b.status["solve_ms"] = 1e3 * (solved - start)
+    b.status["write_ms"] = 1e3 * (time.perf_counter() - solved)
+
+
+@dataclass
+class Request:
+    """What Bind reads from the object and its settings before the basis is computed."""
+
+    rest: np.ndarray
+    used: np.ndarray
+    V: np.ndarray
+    F: np.ndarray
+    groups: list  # vertex indices (deformer's numbering) of each of the scene's handle groups
+    levels: list  # (handle, weight) of each
+    fixed: np.ndarray
+    modes: int
+    eigensolver: str
+
+
+def _check(obj):
+    """Why the settings cannot be bound, or None."""
+    s, groups = obj.specdeform, obj.vertex_groups
+    for i, (group, target, _) in enumerate(handles(obj)):
+        if not group or group not in groups:
+            return f"no vertex group '{group}' for handle {i + 1}"
+        if target is None or target == obj:
+            return f"handle {i + 1}: choose a target object (normally an Empty) other than the mesh"
+    if s.fixed_group and s.fixed_group not in groups:
+        return f"no vertex group '{s.fixed_group}' for the fixed region"
+    if obj.data.shape_keys is not None:
+        return "the mesh has shape keys: apply or remove them first"
+    return None
+
+
+def _levels(h, indices, weights):
+    """The handle's vertices split by weight (rounded to WEIGHT_STEP, at least one step)."""
+    rounded = np.maximum(np.round(weights / WEIGHT_STEP), 1) * WEIGHT_STEP
+    return [(indices[rounded == w], (h, float(w))) for w in np.unique(rounded)]
+
+
+def _shared(names, members):
+    """Two of the groups (handles, fixed) that share vertices, said in one line, or None."""
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            if a == b:
+                return f"vertex group '{a}' is used twice: each vertex follows one handle"
+            if np.intersect1d(members[a][0], members[b][0]).size:
+                return f"vertex groups '{a}' and '{b}' share vertices: each follows one handle"
+    return None
+
+
+def request(obj):
+    """Bind's input from `obj` (its saved rest when it is bound already), or an error message."""
+    s = obj.specdeform
+    problem = _check(obj)
+    if problem:
+        return problem
+    mesh = obj.data
+    rest = mesh_helpers.saved_rest(mesh) if s.bound else None
+    if rest is None:
+        rest = mesh_helpers.coordinates(mesh)
+    F = mesh_helpers.triangles(mesh)
+    if len(F) == 0:
+        return "the mesh has no faces"
+    used = np.flatnonzero(np.bincount(F.ravel(), minlength=len(rest)))  # loose ones stay put
+    if s.modes > len(used):
+        return f"Modes is {s.modes}, more than the mesh's {len(used)} vertices: lower Modes"
+    renumber = np.full(len(rest), -1, np.int64)
+    renumber[used] = np.arange(len(used))
+    F = renumber[F]
+    names = [group for group, _, _ in handles(obj)] + [s.fixed_group] * bool(s.fixed_group)
+    weights = mesh_helpers.group_weights(obj, set(names))
+    members = {}
+    for name, (indices, w) in weights.items():
+        keep = renumber[indices] >= 0
+        if not keep.any():
+            return f"vertex group '{name}' holds no vertex of a face"
+        members[name] = (renumber[indices][keep], w[keep])
+    problem = _shared(names, members)
+    if problem:
+        return problem
+    split = [x for h, (group, _, _) in enumerate(handles(obj)) for x in _levels(h, *members[group])]
+    fixed = members[s.fixed_group][0] if s.fixed_group else np.empty(0, np.int64)
+    return Request(rest, used, rest[used].astype(np.float64), F.astype(np.int32),
+                   [g for g, _ in split], [level for _, level in split], fixed, s.modes,
+                   s.eigensolver)
+
+
+class _Cancelled(Exception):
+    pass
+
+
+class BasisJob:
+    """A Request's basis computed, or loaded from the cache, on a worker thread (the module
+    releases the GIL); cancel() stops it at the solver's next progress report."""
+
+    def __init__(self, request):
+        self.fraction, self.stage, self.result, self.error = 0.0, "starting", None, None
+        self.start, self.seconds = time.perf_counter(), 0.0
+        self._cancel = threading.Event()
+        self._thread = threading.Thread(target=self._run, args=(request,), daemon=True)
+        self._thread.start()
+
+    def _progress(self, fraction, stage):
+        if self._cancel.is_set():
+            raise _Cancelled
+        self.fraction, self.stage = fraction, stage
+
+    def _run(self, r):
+        try:
+            os.makedirs(library.cache_dir(), exist_ok=True)
+            self.result = library.specdeform.manifold_harmonics(
+                r.V, r.F, r.modes, cache=library.cache_dir(), eigensolver=r.eigensolver,
+                progress=self._progress,
+            )
+        except _Cancelled:
+            self.error = "cancelled"
+        except (library.specdeform.Error, OSError) as e:
+            self.error = str(e)
+        self.seconds = time.perf_counter() - self.start
+
+    def cancel(self):
+        self._cancel.set()
+
+    def join(self, timeout=None):
+        self._thread.join(timeout)
+        return self
+
+    @property
+    def done(self):
+        return not self._thread.is_alive()
+
+    def progress_text(self):
+        """'basis: <stage> 40%, about 12 s left' (the estimate once a tenth is done)."""
+        elapsed = time.perf_counter() - self.start
+        text = f"basis: {self.stage} {100 * self.fraction:.0f}%"
+        if self.fraction >= 0.1:
+            text += f", about {elapsed * (1 - self.fraction) / self.fraction:.0f} s left"
+        return text
+
+
+def _basis_line(evals, h):
+    """The panel's line on the basis, saying why it holds more modes than asked."""
+    line = f"{len(evals)} modes" + ("" if h.converged else ", approximate")
+    if h.approximate:
+        line += " (multilevel)"
+    if len(evals) > h.requested_modes > 0:
+        line += f": {h.requested_modes} asked, more as each of {h.pieces} loose parts gets its own"
+    return line
+
+
+def bind(obj, r, job):
+    """Binds `obj` to the basis `job` computed. Returns an error message, or None."""
+    if job.error:
+        return f"bind: {job.error}"
+    s = obj.specdeform
+    sd = library.specdeform
+    start = time.perf_counter()
+    evals, evecs = job.result
+    try:
+        d = sd.SpectralDeformer(
+            r.V,
+            r.F,
+            basis=(evals, evecs),
+            energy=s.energy,
+            detail=s.detail,
+            unconstrained=s.unconstrained,
+            constraint_weight=s.constraint_weight,
+        )
+        d.set_selection(handles=r.groups, fixed=r.fixed)
+    except sd.Error as e:
+        return str(e)
+    h = evecs.base
+    status = {
+        "basis_s": job.seconds,
+        "bind_s": job.seconds + time.perf_counter() - start,
+        "basis": _basis_line(evals, h),
+        "residual": h.max_residual,
+    }
+    # All vertices in faces: a slice, which numpy writes ten times faster than an index array.
+    used = slice(None) if len(r.used) == len(r.rest) else r.used
+    b = Binding(d, r.rest, used, r.levels, positions=r.rest.copy(), status=status)
+    if not s.bound:  # the input stays as it is until a target moves
+        mesh_helpers.save_rest(obj.data, r.rest)
+        for _, target, owner in handles(obj):
+            in_target = target.matrix_world.inverted() @ obj.matrix_world
+            owner.bound_matrix = [x for row in in_target for x in row]
+        s.bound = True
+        b.last = local_transforms(obj)
+    _bindings[obj.name_full] = b
+    problems.pop(obj.name_full, None)
+    update(obj, b)
+    return None
+
+
+def bind_now(obj, report=None):
+    """Bind's whole pipeline on this thread (scripts, the load handler, leaving Edit Mode);
+    report(text) is called every second with the progress. Returns an error message, or None."""
+    r = request(obj)
+    if isinstance(r, str):
+        return r
+    job = BasisJob(r)
+    while not job.done:
+        job.join(1.0)
+        if report and not job.done:
+            report(job.progress_text())
+    return bind(obj, r, job)
+
+
+def release(obj):
+    """Stops following: the binding forgotten, the saved rest dropped."""
+    _bindings.pop(obj.name_full, None)
+    problems.pop(obj.name_full, None)
+    obj.specdeform.bound = False
+    mesh_helpers.drop_rest(obj.data)

@@ -1,0 +1,289 @@
+"""The add-on in an artist's pipeline, headless: keyframed targets, a saved file reopened and
+rendered in new Blender processes with the add-on installed from its zip (no Bind pressed), bakes
+played by a Blender without the add-on, Edit Mode, several handles and weights.
+
+    blender -b --factory-startup --python-exit-code 1 --python pipeline_test.py -- PART
+PART: animation, edit or handles. Environment: SPECDEFORM_BLENDER_DIR, SPECDEFORM_BLENDER_ZIP.
+"""
+
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import zipfile
+
+PART = sys.argv[sys.argv.index("--") + 1]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import support  # noqa: E402
+
+import bmesh  # noqa: E402
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+import specdeform  # noqa: E402
+
+T20 = np.array([[1, 0, 0, 0.3], [0, 0, -1, 0], [0, 1, 0, 0.2], [0, 0, 0, 1]], float)  # 90 deg
+
+
+def bar_scene(name="bar"):
+    V, F = specdeform.bumpy_bar(cells_per_unit=8)
+    handle, fixed = np.flatnonzero(V[:, 0] > 3.6), np.flatnonzero(V[:, 0] < 0.4)
+    obj, empty = support.add_object(name, V, F, handle, fixed)
+    return obj, empty, support.evaluated(obj), F, handle, fixed
+
+
+def direct_pose(rest, F, handles, fixed, transforms):
+    """The library's own solve on the mesh as Blender holds it, with the add-on's defaults."""
+    d = specdeform.SpectralDeformer(rest.astype(np.float64), F, 100, energy="arap")
+    d.set_selection(handles=handles, fixed=fixed)
+    return d.solve(transforms)
+
+
+def keyframe(empty, frame, T):
+    support.move(empty, T)
+    for path in ("location", "rotation_euler"):
+        empty.keyframe_insert(path, frame=frame)
+
+
+def blender(args, user_scripts=None, script=None):
+    """A new Blender process, with the add-on from its zip enabled when user_scripts is given;
+    `script` (Python source) runs after the file in args is loaded."""
+    env = dict(os.environ)
+    env.pop("PYTHONPATH", None)
+    command = ["blender", "-b", "--factory-startup", "--python-exit-code", "1"]
+    if user_scripts:
+        env["BLENDER_USER_SCRIPTS"] = user_scripts
+        command += ["--addons", "specdeform_blender"]
+    command += args + (["--python-expr", script] if script else [])
+    out = subprocess.run(command, env=env, capture_output=True, text=True)
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
+    return out.stdout
+
+
+def installed_from_zip(workdir):
+    """A fresh user scripts folder with the add-on's zip extracted, as Preferences > Install
+    does."""
+    user_scripts = os.path.join(workdir, "user_scripts")
+    with zipfile.ZipFile(os.environ["SPECDEFORM_BLENDER_ZIP"]) as z:
+        z.extractall(os.path.join(user_scripts, "addons"))
+    return user_scripts
+
+
+READ_FRAMES = """
+import bpy, numpy as np
+obj = bpy.data.objects['bar']
+for frame in (20, 1):
+    bpy.context.scene.frame_set(frame)
+    mesh = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+    co = np.empty(3 * len(mesh.vertices), np.float32)
+    mesh.vertices.foreach_get('co', co)
+    np.save(r'{out}' + f'{{frame}}.npy', co.reshape(-1, 3))
+"""
+
+
+def frames_in_new_process(path, workdir, user_scripts):
+    blender([path], user_scripts, READ_FRAMES.format(out=os.path.join(workdir, "frame")))
+    return {f: np.load(os.path.join(workdir, f"frame{f}.npy")) for f in (20, 1)}
+
+
+def render_two_frames(path, workdir, user_scripts):
+    """`blender -b file -a` of frames 1 and 20 (Cycles, 24 x 16 pixels): the two images."""
+    out = os.path.join(workdir, "render_##")
+    blender([path, "-o", out, "-F", "PNG", "-a"], user_scripts)
+    images = []
+    for frame in (1, 20):
+        image = bpy.data.images.load(os.path.join(workdir, f"render_{frame:02d}.png"))
+        images.append(np.array(image.pixels[:]))
+    return images
+
+
+def setup_render(scene, obj):
+    scene.render.engine = "CYCLES"
+    scene.cycles.samples, scene.cycles.use_denoising = 1, False
+    scene.render.resolution_x, scene.render.resolution_y = 24, 16
+    scene.frame_start, scene.frame_end, scene.frame_step = 1, 20, 19
+    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+    scene.collection.objects.link(camera)
+    camera.location = (2, -9, 1)
+    camera.rotation_euler = (math.pi / 2, 0, 0)
+    scene.camera = camera
+    light = bpy.data.objects.new("light", bpy.data.lights.new("light", "SUN"))
+    scene.collection.objects.link(light)
+
+
+def check_animation(workdir):
+    obj, empty, rest, F, handle, fixed = bar_scene()
+    diagonal = support.diagonal(rest)
+    keyframe(empty, 1, np.eye(4))
+    keyframe(empty, 20, T20)
+    scene = bpy.context.scene
+    scene.frame_set(1)
+    support.bind(obj)
+    direct = direct_pose(rest, F, [handle], fixed, [T20])
+    scene.frame_set(20)
+    at20 = support.evaluated(obj)
+    scene.frame_set(1)
+    at1 = support.evaluated(obj)
+    print(f"frame_set: frame 20 vs direct {np.abs(at20 - direct).max() / diagonal:.1e}, "
+          f"frame 1 vs rest {np.abs(at1 - rest).max() / diagonal:.1e}")
+    assert np.abs(at20 - direct).max() <= 1e-5 * diagonal
+    assert np.abs(at1 - rest).max() <= 1e-5 * diagonal
+
+    setup_render(scene, obj)
+    path = os.path.join(workdir, "shot.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    user_scripts = installed_from_zip(workdir)
+    frames = frames_in_new_process(path, workdir, user_scripts)
+    print(f"reopened in a new process: frame 20 vs direct "
+          f"{np.abs(frames[20] - direct).max() / diagonal:.1e}")
+    assert np.abs(frames[20] - direct).max() <= 1e-5 * diagonal
+    assert np.abs(frames[1] - rest).max() <= 1e-5 * diagonal
+    first, last = render_two_frames(path, workdir, user_scripts)
+    print(f"-a render: frames 1 and 20 differ in {np.count_nonzero(first != last)} values")
+    assert np.count_nonzero(first != last) > 0, "frames 1 and 20 rendered the same"
+
+    check_bakes(obj, path, direct, diagonal, workdir)
+
+
+PLAY = """
+import bpy, numpy as np
+assert not hasattr(bpy.types.Object, 'specdeform')
+bpy.context.scene.frame_set(20)
+obj = bpy.data.objects['bar']
+mesh = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+co = np.empty(3 * len(mesh.vertices), np.float32)
+mesh.vertices.foreach_get('co', co)
+np.save(r'{out}', co.reshape(-1, 3))
+"""
+
+
+def check_bakes(obj, path, direct, diagonal, workdir):
+    """Bakes of frames 1-20 to a point cache and to shape keys, played at frame 20 by a Blender
+    without the add-on, and frame 20's pose baked to one shape key."""
+    played = {}
+    for kind in ("POINT_CACHE", "SHAPE_KEYS"):
+        bpy.ops.wm.open_mainfile(filepath=path)  # bound again by the load handler
+        cache = os.path.join(workdir, "bar.pc2")
+        assert bpy.ops.specdeform.bake(frame_start=1, frame_end=20, kind=kind,
+                                       filepath=cache) == {"FINISHED"}
+        baked = os.path.join(workdir, f"{kind}.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=baked)
+        out = os.path.join(workdir, f"{kind}.npy")
+        blender([baked], script=PLAY.format(out=out))
+        played[kind] = np.load(out)
+        miss = np.abs(played[kind] - direct).max() / diagonal
+        print(f"bake {kind} played without the add-on: frame 20 vs direct {miss:.1e}")
+        assert miss <= 1e-4, miss
+
+    # The pose of frame 20 kept as one shape key, on, over the rest; the mesh unbound.
+    bpy.ops.wm.open_mainfile(filepath=path)
+    bpy.context.scene.frame_set(20)
+    assert bpy.ops.specdeform.bake_pose() == {"FINISHED"}
+    obj = bpy.data.objects["bar"]
+    bpy.context.scene.frame_set(1)
+    assert not obj.specdeform.bound and obj.data.shape_keys.key_blocks[1].value == 1.0
+    assert np.abs(support.evaluated(obj) - direct).max() <= 1e-4 * diagonal
+
+
+def check_edit_mode():
+    """An Edit Mode move of a free vertex by 0.5 changes the rest shape: it is still 0.5 from its
+    neighbours' average (within 10%) after the target moves again."""
+    obj, empty, rest, F, handle, fixed = bar_scene()
+    support.bind(obj)
+    support.move(empty, T20)
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.context.view_layer.update()
+    bm = bmesh.from_edit_mesh(obj.data)
+    shown = np.array([v.co for v in bm.verts])
+    assert np.abs(shown - rest).max() <= 1e-6, "Edit Mode does not show the rest shape"
+    free = int(np.argmin(np.abs(rest[:, 0] - 2.0) + np.abs(rest[:, 2] - rest[:, 2].max())))
+    bm.verts.ensure_lookup_table()
+    v = bm.verts[free]
+    neighbours = [e.other_vert(v).index for e in v.link_edges]
+    v.co.z += 0.5
+    bmesh.update_edit_mesh(obj.data)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    bpy.context.view_layer.update()
+    assert "edited rest" in " ".join(support.panel_lines(obj))
+    c, s = math.cos(1.0), math.sin(1.0)
+    support.move(empty, np.array([[1, 0, 0, 0.3], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]]))
+    X = support.evaluated(obj)
+    bump = np.linalg.norm(X[free] - X[neighbours].mean(axis=0))
+    before = np.linalg.norm(rest[free] - rest[neighbours].mean(axis=0))
+    print(f"Edit Mode move 0.5: {bump:.3f} from the neighbours' average after a move "
+          f"(before the edit {before:.3f})")
+    assert abs(bump - 0.5) <= 0.05, bump
+
+    # Vertices added (an edge of the free vertex split): bound again on the new mesh, posed.
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.context.view_layer.update()
+    bm = bmesh.from_edit_mesh(obj.data)
+    bm.verts.ensure_lookup_table()
+    bmesh.ops.subdivide_edges(bm, edges=bm.verts[free].link_edges[:1], cuts=1)
+    bmesh.update_edit_mesh(obj.data)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    bpy.context.view_layer.update()
+    assert len(support.binding.binding(obj).rest) == len(rest) + 1
+    moved = support.evaluated(obj)[: len(rest)]
+    assert np.abs(moved - X).max() <= 0.01 * support.diagonal(rest), "the pose was not applied"
+
+
+def check_handles():
+    """Two handles, two Empties: both reached, also when a driver moves one; then one handle of
+    weight 0.5 moves half way."""
+    V, F = specdeform.bumpy_bar(cells_per_unit=8)
+    ends = np.flatnonzero(V[:, 0] > 3.6), np.flatnonzero(V[:, 0] < 0.4)
+    middle = np.flatnonzero(np.abs(V[:, 0] - 2) < 0.2)
+    obj, first = support.add_object("two", V, F, ends[0], middle)
+    rest = support.evaluated(obj)
+    diagonal = support.diagonal(rest)
+    obj.vertex_groups.new(name="left").add([int(i) for i in ends[1]], 1.0, "REPLACE")
+    second = bpy.data.objects.new("second", None)
+    bpy.context.scene.collection.objects.link(second)
+    item = obj.specdeform.handles.add()
+    item.group, item.target = "left", second
+    support.bind(obj)
+    up, down = np.eye(4), np.eye(4)
+    up[:3, 3], down[:3, 3] = (0, 0, 0.5), (0, 0.3, -0.4)
+    support.move(first, up)
+    support.move(second, down)
+    X = support.evaluated(obj)
+    misses = [np.linalg.norm(X[g] - support.apply_transform(T, rest[g]), axis=1).max() / diagonal
+              for g, T in zip(ends, (up, down))]
+    print(f"two handles: misses {misses[0]:.1e}, {misses[1]:.1e} of the diagonal")
+    assert max(misses) <= 0.005, misses
+
+    # A driver moves the second Empty with the frame: frame_set poses it.
+    support.move(second, np.eye(4))
+    fcurve = second.driver_add("location", 2)
+    fcurve.driver.expression = "frame / 40"
+    bpy.context.scene.frame_set(20)
+    X = support.evaluated(obj)
+    down[:3, 3] = (0, 0, 0.5)
+    miss = np.linalg.norm(X[ends[1]] - support.apply_transform(down, rest[ends[1]]), axis=1).max()
+    print(f"driver: miss {miss / diagonal:.1e} of the diagonal")
+    assert miss <= 0.005 * diagonal, miss / diagonal
+    second.driver_remove("location", 2)
+
+    assert bpy.ops.specdeform.unbind() == {"FINISHED"}
+    obj.vertex_groups["handle"].add([int(i) for i in ends[0]], 0.5, "REPLACE")
+    support.move(first, np.eye(4))
+    support.move(second, np.eye(4))
+    support.bind(obj)
+    support.move(first, up)
+    X = support.evaluated(obj)
+    half = np.abs(X[ends[0]] - (rest[ends[0]] + 0.5 * up[:3, 3])).max() / diagonal
+    print(f"weight 0.5: {half:.1e} of the diagonal from half way")
+    assert half <= 0.005, half
+
+
+def main():
+    support.fresh_file()
+    with tempfile.TemporaryDirectory() as workdir:
+        os.environ["XDG_CACHE_HOME"] = workdir  # a fresh basis cache, shared with the children
+        {"animation": lambda: check_animation(workdir), "edit": check_edit_mode,
+         "handles": check_handles}[PART]()
+    print("passed")
+
+
+main()
