@@ -98,7 +98,10 @@ export type ServerText =
   | StateMessage
   | ErrorMessage
   | { type: 'empty'; request: string }
-  | { type: 'note'; message: string }; // what an export dropped or changed
+  | { type: 'note'; message: string } // what an export dropped or changed
+  // The basis just computed, written to the cache in the background (after "ready"): once when
+  // it starts, once when it is done (with its size and time, or the error).
+  | { type: 'saving'; file: string; done: boolean; seconds?: number; bytes?: number; error?: string };
 
 // ---------------------------------------------------------------- JSON, browser -> server
 
