@@ -50,6 +50,9 @@ try {
   // Every status the page shows, with when it was first shown (ms from navigation).
   await page.addInitScript(() => {
     window.statusLog = [];
+    window.longTasks = []; // [start, duration] (ms) of tasks that held the page over 50 ms
+    new PerformanceObserver((l) => window.longTasks.push(...l.getEntries().map((e) => [e.startTime, e.duration])))
+      .observe({ entryTypes: ['longtask'] });
     document.addEventListener('DOMContentLoaded', () => {
       const status = document.getElementById('status');
       new MutationObserver(() => {
@@ -165,6 +168,7 @@ try {
   const start = await screen(ends.handle);
   const drawnBefore = await api(() => window.specdeformEditor.stats.framesDrawn);
   const td = Date.now();
+  result.drag_started_s = (await now()) / 1000;
   await page.mouse.move(start.x, start.y);
   await page.mouse.down();
   for (let i = 1; i <= 12; ++i) await page.mouse.move(start.x, start.y - 10 * i);
@@ -174,6 +178,9 @@ try {
   result.drag_12_steps_play_s = (up - td) / 1000;
   result.drag_detailed_after_release_s = (Date.now() - up) / 1000;
   result.first_drag_drawn_s = (await now()) / 1000;
+  // Where the page's main thread was held (tasks over 50 ms), up to the drag's detail.
+  result.long_tasks_s = (await api(() => window.longTasks)).sort((a, b) => b[1] - a[1]).slice(0, 8)
+    .map(([t, d]) => [+(t / 1000).toFixed(2), +(d / 1000).toFixed(2)]);
   const moved = await api(() => window.specdeformEditor.transforms()[0]);
   check(Math.hypot(moved[3], moved[7], moved[11]) > 0, 'the drag moved the handle');
   check((await api(() => window.specdeformEditor.stats.framesDrawn)) > drawnBefore, 'the drag was drawn');

@@ -415,8 +415,8 @@ export class Viewer {
     return this.drawMs;
   }
 
-  // Draws on the next animation frame. A slow draw (a large mesh without a GPU) is followed by
-  // as long without one, so that pointer events, which wait for the frame being drawn, still
+  // Draws on the next animation frame. A slow draw (the full large mesh without a GPU) is
+  // followed by as long without one, so that pointer events, which wait for the frame being drawn, still
   // come in at once half of the time.
   requestRender(): void {
     if (this.renderQueued) return;
@@ -429,7 +429,8 @@ export class Viewer {
       this.onRendered();
       if (!this.bvh && this.geometry.index) setTimeout(() => (this.bvh ??= new MeshBVH(this.geometry)));
     });
-    const wait = this.drawMs > kSlowDrawMs ? this.lastDraw + this.drawMs - performance.now() : 0;
+    const slow = this.drawMs > kSlowDrawMs && !this.coarse.visible; // the preview draws fast
+    const wait = slow ? this.lastDraw + this.drawMs - performance.now() : 0;
     if (wait > 0) setTimeout(draw, wait);
     else draw();
   }
