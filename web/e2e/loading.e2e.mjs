@@ -141,6 +141,7 @@ try {
     const e = window.specdeformEditor;
     return e.ready && e.serverCounts()?.handles > 0;
   }, null, { timeout: 300000 });
+  result.selection_applied_s = (await now()) / 1000;
   result.ready_s = (await api(() => window.statusLog.find((s) => /: ready/.test(s.text))?.t ?? performance.now())) / 1000;
   const applied = await api(() => window.specdeformEditor.serverCounts());
   check(applied.handles === painted.handles && applied.fixed === painted.fixed,
@@ -191,6 +192,7 @@ try {
   const saved = await api(() => ({ notes: window.specdeformEditor.notes().map((n) => n.text), log: window.statusLog.map((s) => s.text) }));
   check(saved.log.some((t) => /saving the basis for next time/.test(t)), `the status said the basis was being saved (${JSON.stringify(saved.log.slice(-4))})`);
   check(saved.notes.some((t) => /saved the basis for next time/.test(t)), `the basis was saved (${JSON.stringify(saved.notes)})`);
+  result.saved = saved.notes.find((t) => /saved the basis/.test(t));
 
   // 6. Pointer moves coalesce: 40 moves within one task are acted on once or twice.
   const coalesced = await api(() => new Promise((done) => {

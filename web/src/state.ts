@@ -469,9 +469,18 @@ export class EditorState {
     const wanted = this.drawMs > kFullDrawBudgetMs;
     const size = Math.round(Math.max(2000, Math.min(n / 3, (n * kPreviewMs) / this.drawMs)));
     this.previewWanted = wanted;
-    if (wanted && this.viewer.previewSize !== size) this.connection.send({ type: 'preview', vertices: size });
+    if (wanted && this.viewer.previewSize !== size) this.previewRequest = { type: 'preview', vertices: size };
+    if (!this.preparing) this.sendPreviewRequest();
     this.changed();
   }
+
+  // The server sets the preview's deformer up (seconds at a million vertices) after the
+  // selection painted while the mesh was prepared, not before it.
+  private sendPreviewRequest(): void {
+    if (this.previewRequest) this.connection.send(this.previewRequest);
+    this.previewRequest = null;
+  }
+  private previewRequest: P.ClientText | null = null;
 
   private adoptSelection(s: P.Selection): void {
     const empty = s.groups.length === 0 && s.fixed.length === 0;
@@ -512,6 +521,7 @@ export class EditorState {
       this.selectionHeld = false;
       this.sendSelection();
     }
+    if (!this.preparing) this.sendPreviewRequest();
     if (!this.restoreChecked) {
       this.restoreChecked = true;
       const restarted = m.groups.length === 0 && m.fixed === 0 && !m.undo;
