@@ -292,24 +292,33 @@ export class Interaction {
     this.s.changed();
   }
 
-  // Whether the vertices labelled `label` (nearly all) face the camera while the surface within their
-  // reach has as many again facing away: one side of a thin part.
+  // Whether the vertices labelled `label` (nearly all) face the camera while as many again face
+  // away right behind them (across the view, within their reach; along it, within 30% of the
+  // diagonal): one side of a thin part.
   private oneSided(label: number): boolean {
     const v = this.s.viewer;
     const p = v.positions();
     const nrm = v.normals();
-    const view = v.camera.getWorldDirection(new THREE.Vector3());
-    const facing = (k: number) => nrm[3 * k] * view.x + nrm[3 * k + 1] * view.y + nrm[3 * k + 2] * view.z;
-    const c = new THREE.Vector3();
+    const d = v.camera.getWorldDirection(new THREE.Vector3());
+    const facing = (k: number) => nrm[3 * k] * d.x + nrm[3 * k + 1] * d.y + nrm[3 * k + 2] * d.z;
     const members: number[] = [];
-    this.s.labels.forEach((l, k) => l === label && (members.push(k), c.add(new THREE.Vector3(p[3 * k], p[3 * k + 1], p[3 * k + 2]))));
+    this.s.labels.forEach((l, k) => l === label && members.push(k));
     if (members.length === 0 || members.filter((k) => facing(k) > 0.1).length > 0.1 * members.length) return false;
+    const c = new THREE.Vector3();
+    for (const k of members) c.add(new THREE.Vector3().fromArray(p, 3 * k));
     c.divideScalar(members.length);
-    let reach = 0;
-    for (const k of members) reach = Math.max(reach, c.distanceToSquared(new THREE.Vector3(p[3 * k], p[3 * k + 1], p[3 * k + 2])));
+    const q = new THREE.Vector3();
+    const offset = (k: number) => {
+      q.fromArray(p, 3 * k).sub(c);
+      const along = q.dot(d);
+      return { along, across: q.addScaledVector(d, -along).length() };
+    };
+    const reach = Math.max(...members.map((k) => offset(k).across));
     let behind = 0;
     this.s.labels.forEach((l, k) => {
-      if (l !== label && facing(k) > 0.3 && (p[3 * k] - c.x) ** 2 + (p[3 * k + 1] - c.y) ** 2 + (p[3 * k + 2] - c.z) ** 2 < reach) ++behind;
+      if (l === label || facing(k) < 0.3) return;
+      const o = offset(k);
+      if (o.across < reach && o.along > 0 && o.along < 0.3 * this.s.diagonal) ++behind;
     });
     return behind > 0.5 * members.length;
   }
