@@ -79,7 +79,7 @@ export class Interaction {
 
   get radius(): number {
     const percent = Number((document.getElementById('radius') as HTMLInputElement).value);
-    return (percent / 100) * (this.s.diagonal);
+    return (percent / 100) * this.s.diagonal;
   }
 
   private get geodesic(): boolean {

@@ -42,10 +42,11 @@ export interface Settings {
 
 // ---------------------------------------------------------------- JSON, server -> browser
 
+// While a basis is prepared; a mesh being opened is sent before its first one (drawn, painted).
 export interface ProgressMessage {
   type: 'progress';
   stage: string;
-  fraction: number;
+  fraction: number; // 1 for a stage without a fraction of its own ("setting up the solver")
   cancellable: boolean;
 }
 
