@@ -123,6 +123,12 @@ class Connection : public std::enable_shared_from_this<Connection> {
   std::deque<Message> queue_;
 };
 
+// Whether a text message is of `type` (the JSON's keys are sorted: "type" is not the first; a
+// string value cannot hold the unescaped quotes).
+bool is_type(const std::string& message, const std::string& type) {
+  return message.find(R"("type":")" + type + '"') != std::string::npos;
+}
+
 }  // namespace
 
 struct EditorServer::Impl {
@@ -137,16 +143,35 @@ struct EditorServer::Impl {
   std::mutex connection_mutex;
   std::shared_ptr<Connection> connection;  // the editor window being served
   std::string progress;                    // the last progress message while one is running
+  std::vector<std::string> preparing;      // the mesh (and its look) whose basis is computed
 
   void send(bool binary, std::string data) {
     std::shared_ptr<Connection> c;
     {
       std::lock_guard lock(connection_mutex);
       c = connection;
-      const bool is_progress = !binary && data.starts_with(R"({"type":"progress")");
-      progress = is_progress ? data : std::string();
+      const bool is_progress = !binary && is_type(data, "progress");
+      if (!is_progress && !binary) progress.clear();
+      if (is_progress) progress = data;
+      keep_preparing(binary, data);
     }
     if (c) c->send(binary, std::move(data));
+  }
+
+  // The mesh sent before its basis, for a window that connects while the basis is computed;
+  // forgotten when the mesh is ready or was not opened (ready, empty, error).
+  void keep_preparing(bool binary, const std::string& data) {
+    if (!binary) {
+      if (is_type(data, "ready") || is_type(data, "empty") || is_type(data, "error")) {
+        preparing.clear();
+      }
+      return;
+    }
+    const Tag tag = message_tag(data);
+    if (tag == Tag::Mesh) preparing = {data};
+    if (!preparing.empty() && (tag == Tag::Appearance || tag == Tag::Texture)) {
+      preparing.push_back(data);
+    }
   }
 
   void attach(const std::shared_ptr<Connection>& c) {
@@ -154,6 +179,7 @@ struct EditorServer::Impl {
     {
       std::lock_guard lock(connection_mutex);
       previous = std::exchange(connection, c);
+      for (const std::string& m : preparing) c->send(true, m);
       if (!progress.empty()) c->send(false, progress);
     }
     if (previous) previous->close("another editor window connected");

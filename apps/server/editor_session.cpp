@@ -1,5 +1,7 @@
 #include "editor_session.h"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -7,6 +9,7 @@
 #include <fstream>
 #include <iostream>
 #include <new>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -102,6 +105,23 @@ FileResolver uploaded_companions(std::shared_ptr<const std::map<std::string, std
     }
     return std::nullopt;
   };
+}
+
+// Writes `basis` to the cache file `file`; returns the "saving" message that says how it went.
+Json save_and_report(const std::filesystem::path& file, const ManifoldHarmonics& basis,
+                     const TriangleMesh& mesh) {
+  const Clock::time_point start = Clock::now();
+  Json out = {{"type", "saving"}, {"file", file.filename().string()}, {"done", true}};
+  try {
+    save_basis(file, basis, mesh);
+    out["bytes"] = std::filesystem::file_size(file);
+    out["error"] = "";
+  } catch (const std::exception& e) {
+    std::cerr << "specdeform: warning: basis not cached: " << e.what() << "\n";
+    out["error"] = e.what();
+  }
+  out["seconds"] = seconds_since(start);
+  return out;
 }
 
 // At most this many companions wait for their mesh file.
@@ -288,10 +308,7 @@ void EditorSession::text_message(std::string_view message) {
   if (!state_) throw InputError("no mesh is open");
   State& s = *state_;
   if (type == "hello") {
-    send_mesh();
-    send_ready();
-    send_selection();
-    if (s.has_handles) solve_and_send();
+    resend_edit();
     return send_state();
   }
   if (type == "settings") return change_settings(message);
@@ -415,6 +432,7 @@ void EditorSession::change_settings(std::string_view message) {
                             o.unconstrained != s.options.unconstrained;
   if (new_deformer) {
     const PreparedBasis basis = new_basis ? compute_basis(s.rest_mesh(s.pose), modes) : s.basis();
+    if (new_basis) progress("setting up the solver", 1.0, false);
     SpectralDeformer deformer(s.rest_mesh(s.pose), basis.harmonics, o);
     if (s.has_handles) deformer.set_selection(s.solved(s.edit.selection));
     s.deformer.emplace(std::move(deformer));
@@ -422,6 +440,7 @@ void EditorSession::change_settings(std::string_view message) {
     if (new_basis) {  // the other poses' bases have the old m
       for (PreparedBasis& b : s.bases) b.harmonics.reset();
       s.bases[s.pose] = basis;
+      save_in_background();
     }
     s.modes = modes;
     s.options = o;
@@ -498,11 +517,15 @@ void EditorSession::restore(size_t entry) {
   const Entry& e = s.history[entry];
   if (e.pose != s.pose) {
     PreparedBasis& basis = s.bases[e.pose];
-    if (!basis.harmonics) basis = compute_basis(s.rest_mesh(e.pose), s.modes);
+    if (!basis.harmonics) {
+      basis = compute_basis(s.rest_mesh(e.pose), s.modes);
+      progress("setting up the solver", 1.0, false);
+    }
     SpectralDeformer deformer(s.rest_mesh(e.pose), basis.harmonics, s.options);
     s.deformer.emplace(std::move(deformer));
     watch_detail();
     s.pose = e.pose;
+    save_in_background();
     s.has_handles = false;
     s.result = s.rest();
     s.result_stale = false;
@@ -528,6 +551,7 @@ void EditorSession::apply_pose() {
   } else {
     reused.reset();
     basis = compute_basis(posed, s.modes);
+    progress("setting up the solver", 1.0, false);
   }
   SpectralDeformer deformer(posed, basis.harmonics, s.options);
   commit();  // undo returns to the pose as it was dragged
@@ -552,6 +576,7 @@ void EditorSession::apply_pose() {
     s.bases[p].harmonics.reset();
   }
   s.pose = static_cast<int>(s.poses.size()) - 1;
+  save_in_background();
   s.has_handles = false;
   s.result = s.rest();
   s.result_stale = false;
@@ -604,6 +629,13 @@ void EditorSession::open(LoadedMesh mesh, std::string name) {
   build(std::move(mesh), std::move(name), config_.modes, config_.options);
 }
 
+void EditorSession::progress(std::string_view stage, double fraction, bool cancellable) {
+  send_(false, dump({{"type", "progress"},
+                     {"stage", stage},
+                     {"fraction", fraction},
+                     {"cancellable", cancellable}}));
+}
+
 PreparedBasis EditorSession::compute_basis(const TriangleMesh& mesh, int modes) {
   struct Computing {
     std::atomic<bool>& flag;
@@ -612,20 +644,19 @@ PreparedBasis EditorSession::compute_basis(const TriangleMesh& mesh, int modes) 
   } computing(computing_);
   cancelled_ = false;
   Clock::time_point last_report{};
+  std::string last_stage;
   const auto report = [&](double fraction, std::string_view stage) {
     if (cancelled_) throw Cancelled();
-    if (seconds_since(last_report) < 0.1 && fraction < 1.0) return;
+    if (seconds_since(last_report) < 0.1 && fraction < 1.0 && stage == last_stage) return;
     last_report = Clock::now();
-    send_(false, dump({{"type", "progress"},
-                       {"stage", stage},
-                       {"fraction", fraction},
-                       {"cancellable", true}}));
+    last_stage = stage;
+    const bool loading = stage == "loading the basis";
+    progress(loading ? std::string(stage) : "computing the basis: " + std::string(stage), fraction,
+             true);
   };
   const EigenSolver solver =
       config_.eigensolver.value_or(default_eigensolver(mesh.num_vertices(), {}));
-  PreparedBasis out = prepare_basis(mesh, modes, solver, config_.cache_dir, report);
-  report(1.0, "factorizing");
-  return out;
+  return prepare_basis(mesh, modes, solver, config_.cache_dir, report);
 }
 
 void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
@@ -636,16 +667,23 @@ void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
   State& s = *next;
   s.modes = std::min(modes, n - 1);
   s.options = options;
+  s.appearance = file_appearance(mesh);
+  // Drawn at once: the page shows it, and handles are painted, while the basis computes.
+  send_mesh(mesh.mesh, s.appearance, mesh);
   PreparedBasis basis;
   try {
     basis = compute_basis(mesh.mesh, s.modes);
+    progress("setting up the solver", 1.0, false);
+    s.deformer.emplace(mesh.mesh, basis.harmonics, s.options);
   } catch (const SolverError& e) {
+    resend_edit();
     throw SolverError(name + ": " + e.what());
+  } catch (...) {
+    resend_edit();  // the page shows the mesh that stays open
+    throw;
   }
-  s.deformer.emplace(mesh.mesh, basis.harmonics, s.options);
   s.bases.push_back(std::move(basis));
   s.poses.push_back({mesh.mesh.V, hex(mesh_hash(mesh.mesh))});
-  s.appearance = file_appearance(mesh);
   s.loaded = std::move(mesh);
   s.name = std::move(name);
   s.result = s.rest();
@@ -653,20 +691,48 @@ void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
   s.history.push_back({s.edit, 0});
   state_ = std::move(next);
   watch_detail();
-  send_mesh();
   send_ready();
   send_selection();
   send_state();
+  save_in_background();
+}
+
+void EditorSession::resend_edit() {
+  if (!state_) return;
+  send_mesh();
+  send_ready();
+  send_selection();
+  if (state_->has_handles) solve_and_send();
+}
+
+void EditorSession::save_in_background() {
+  State& s = *state_;
+  PreparedBasis& b = s.bases[s.pose];
+  if (b.save_to.empty()) return;
+  const std::filesystem::path file = std::exchange(b.save_to, {});
+  send_(false, dump({{"type", "saving"}, {"file", file.filename().string()}, {"done", false}}));
+  if (saving_.valid()) saving_.wait();  // one file at a time
+  saving_ =
+      std::async(std::launch::async, [this, file, basis = b.harmonics, mesh = s.rest_mesh(s.pose)] {
+        // The lowest CPU priority (this thread's own on Linux): it never takes a core from a drag.
+        setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 19);
+        send_(false, dump(save_and_report(file, *basis, mesh)));
+      });
 }
 
 void EditorSession::send_mesh() {
   const State& s = *state_;
-  send_(true, encode_mesh_message(s.rest_mesh(s.pose)));
-  if (!s.appearance) return;
-  send_(true, encode_appearance(*s.appearance));
-  for (size_t m = 0; m < s.appearance->textured.size(); ++m) {
-    if (!s.appearance->textured[m]) continue;
-    if (const auto image = s.loaded.file->texture(static_cast<int>(m))) {
+  send_mesh(s.rest_mesh(s.pose), s.appearance, s.loaded);
+}
+
+void EditorSession::send_mesh(const TriangleMesh& rest, const std::optional<Appearance>& look,
+                              const LoadedMesh& loaded) {
+  send_(true, encode_mesh_message(rest));
+  if (!look) return;
+  send_(true, encode_appearance(*look));
+  for (size_t m = 0; m < look->textured.size(); ++m) {
+    if (!look->textured[m]) continue;
+    if (const auto image = loaded.file->texture(static_cast<int>(m))) {
       send_(true, encode_texture(static_cast<uint32_t>(m), image->second, image->first));
     }
   }

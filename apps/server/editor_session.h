@@ -23,6 +23,14 @@
 //     {"type": "cancel"}             handled by the server at once: see cancel()
 //   server -> browser
 //     {"type": "progress", "stage": s, "fraction": f, "cancellable": b}
+//                                    while a basis is prepared (after the mesh message of a mesh
+//                                    being opened: the page draws it and paints handles
+//                                    meanwhile, and sends the selection after "ready"); fraction 1
+//                                    for a stage that has none ("setting up the solver")
+//     {"type": "saving", "file", "done": false}, then {"type": "saving", "file", "done": true,
+//      "seconds", "bytes" (when saved), "error" ("" when saved)}
+//                                    a computed basis written to the cache in the background,
+//                                    after "ready"
 //     {"type": "ready", "name", "vertices", "faces", "diagonal", "mesh_id", "modes", "settings",
 //      "pose", "basis": {"seconds", "source": "computed|cache|reused", "residual", "warning"},
 //      "setup": {...}, "arap_clusters"}         after a mesh message or a settings request
@@ -44,6 +52,7 @@
 #include <atomic>
 #include <filesystem>
 #include <functional>
+#include <future>
 #include <map>
 #include <memory>
 #include <optional>
@@ -106,8 +115,9 @@ class EditorSession {
   EditorSession(EditorConfig config, Send send, Post post = {});
   ~EditorSession();
 
-  // Computes (or loads) the basis and builds the deformer, then announces the mesh. Throws
-  // InputError, SolverError or Cancelled, keeping the previous mesh, if that fails.
+  // Sends the mesh, computes (or loads) the basis and builds the deformer, then announces the
+  // mesh as ready. Throws InputError, SolverError or Cancelled, keeping the previous mesh (sent
+  // again), if that fails.
   void open(LoadedMesh mesh, std::string name);
 
   // Handles one message; errors are answered with an error message, never thrown.
@@ -143,6 +153,12 @@ class EditorSession {
   // details (waits for its background factorisation; exports and poses).
   const Vertices& result(bool final = false);
   void send_mesh();  // with the file's appearance and textures, if it has them
+  void send_mesh(const TriangleMesh& rest, const std::optional<Appearance>& look,
+                 const LoadedMesh& loaded);
+  void resend_edit();  // the mesh, settings, selection and frame of the open edit, if any
+  void progress(std::string_view stage, double fraction, bool cancellable);
+  // The basis just computed written to the cache on a thread of its own ("saving" messages).
+  void save_in_background();
   void send_ready();
   void send_selection();
   void send_state();
@@ -163,6 +179,7 @@ class EditorSession {
   std::string request_;     // the type of the message being handled
   std::string last_error_;  // of the last request that failed
   std::unique_ptr<State> state_;
+  std::future<void> saving_;  // the basis being cached; last: waited for before the rest goes
 };
 
 }  // namespace specdeform::server

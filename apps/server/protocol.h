@@ -19,7 +19,8 @@
 //   6 companion    the same layout as 3: a file the next mesh file names (an MTL, a texture, a
 //                  .gltf's buffer), by that name; sent before the mesh file
 // Server -> browser
-//   101 mesh       u32 tag | u32 n | u32 triangles T | f32 positions (3 n) | u32 corners (3 T)
+//   101 mesh       u32 tag | u32 n | u32 triangles T | f32 positions (3 n) | u32 corners (3 T);
+//                  a mesh being opened is sent before its basis is computed
 //   102 frame      u32 tag | u32 seq | u32 n | u32 view (bit 0: smooth base, bit 1: preview,
 //                  bit 2: the smooth base folded, details added as displacements there) |
 //                  f32 reduced solve, inverse transform, detail, total (ms) |

@@ -229,6 +229,7 @@ ManifoldHarmonics compute_manifold_harmonics(const Sparse& K, const Sparse& M,
 
 ManifoldHarmonics compute_manifold_harmonics(const TriangleMesh& mesh,
                                              const ManifoldHarmonicsOptions& options) {
+  detail::report(options, 0.0, "the Laplacian");
   const LaplacianOperators L = laplacian_operators(mesh, options.mass, options.laplacian);
   const Sparse lengths = options.solver == EigenSolver::Multilevel
                              ? detail::edge_lengths(L.stiffness, mesh.V)

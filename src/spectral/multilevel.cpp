@@ -66,6 +66,7 @@ Spectrum solve_multilevel(const Sparse& K, const Sparse& M, const Sparse& length
       p.multilevel_support);
   const Sparse& P = coarse.prolongation;
   const int N = static_cast<int>(P.cols());
+  report(o, 0.05, "coarse operators");
   const auto [Kc, Mc] = galerkin_products(K, M, P, coarse.rows);
 
   // One pair more than m tells whether m ends inside a cluster.

@@ -2,6 +2,7 @@
 # Runs the browser editor's end-to-end test (web/e2e/editor.e2e.mjs) in Debian's Chromium.
 # Usage: e2e_test.sh SPECDEFORM_BINARY WEB_DIR OUTPUT_DIR [MESH [SUBDIVIDE] [-- E2E_ARGS...]]
 # MESH: a file, tried as given; SUBDIVIDE: refine it that many times first (into OUTPUT_DIR).
+# E2E_SCRIPT: another script of web/e2e taking the same options (default editor.e2e.mjs).
 # Exit 77 (skipped) without Chromium, Node.js >= 20, the editor's npm packages, or the mesh
 # (the shared test meshes are not in every checkout).
 set -u
@@ -31,5 +32,5 @@ if [ -n "$mesh" ]; then
   fi
   mesh_args=(--mesh "$mesh")
 fi
-exec node "$web/e2e/editor.e2e.mjs" --binary "$bin" --chromium "$chromium" --out "$out" \
+exec node "$web/e2e/${E2E_SCRIPT:-editor.e2e.mjs}" --binary "$bin" --chromium "$chromium" --out "$out" \
   "${mesh_args[@]}" "$@"

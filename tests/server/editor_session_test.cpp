@@ -1,9 +1,12 @@
 #include "editor_session.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <condition_variable>
 #include <cstring>
 #include <deque>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <numeric>
@@ -557,6 +560,108 @@ TEST(EditorSessionCancel, CancelKeepsThePreviousState) {
   EXPECT_TRUE(error["cancelled"]);
   EXPECT_EQ(texts.back()["type"], "ready");
   EXPECT_EQ(texts.back()["modes"], 20);
+}
+
+// The mesh is sent as soon as it is read, before its basis's progress, so that the page draws
+// it and handles are painted meanwhile; a stage without a fraction of its own (the solver's
+// set-up) has its label, not a "100%" of the basis.
+TEST(EditorSessionOpen, SendsTheMeshBeforeItsBasis) {
+  std::vector<std::string> order;
+  EditorSession session(EditorConfig{.modes = 20}, [&](bool binary, std::string data) {
+    order.push_back(
+        binary ? std::to_string(static_cast<uint32_t>(message_tag(data)))
+               : Json::parse(data)["type"].get<std::string>() +
+                     (data.find("setting up the solver") != std::string::npos ? " setup" : ""));
+  });
+  LoadedMesh mesh;
+  mesh.mesh = make_icosphere(3);
+  mesh.info = identity_read_info(mesh.mesh);
+  session.open(std::move(mesh), "sphere.obj");
+  const auto at = [&](const std::string& what) {
+    return std::find(order.begin(), order.end(), what) - order.begin();
+  };
+  EXPECT_EQ(order.front(), std::to_string(static_cast<uint32_t>(Tag::Mesh)));
+  EXPECT_LT(at("progress"), at("progress setup"));
+  EXPECT_LT(at("progress setup"), at("ready"));
+  EXPECT_EQ(std::count(order.begin(), order.end(), order.front()), 1);  // sent once
+}
+
+// A new mesh cancelled while its basis computes: the page gets the open mesh back.
+TEST(EditorSessionOpen, ACancelledOpenSendsTheOpenMeshBack) {
+  std::vector<Sent> sent;
+  EditorSession* self = nullptr;
+  bool armed = false;
+  EditorSession session(EditorConfig{.modes = 20}, [&](bool binary, std::string data) {
+    if (armed && !binary && Json::parse(data)["type"] == "progress") self->cancel();
+    sent.push_back({binary, std::move(data)});
+  });
+  self = &session;
+  LoadedMesh first;
+  first.mesh = make_icosphere(2);
+  first.info = identity_read_info(first.mesh);
+  session.open(std::move(first), "small.obj");
+  sent.clear();
+  armed = true;
+  session.handle(true, encode_file({"big.obj", encode_mesh(make_icosphere(4), MeshFormat::Obj)},
+                                   Tag::MeshFile));
+  std::vector<uint32_t> vertices;
+  for (const Sent& m : sent) {
+    if (m.binary && message_tag(m.data) == Tag::Mesh) {
+      vertices.push_back(0);
+      std::memcpy(&vertices.back(), m.data.data() + 4, 4);
+    }
+  }
+  EXPECT_EQ(vertices, (std::vector<uint32_t>{2562, 162}));  // the new one, then the open one
+  EXPECT_EQ(Json::parse(sent.back().data)["type"], "error");
+}
+
+// A computed basis is saved to the cache after "ready", in the background, and the page is told
+// when it starts and when it is done; the next open loads it.
+TEST(EditorSessionOpen, SavesTheBasisInTheBackground) {
+  const std::filesystem::path cache =
+      std::filesystem::temp_directory_path() / ("specdeform-save-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(cache);
+  std::mutex mutex;
+  std::condition_variable saved;
+  std::vector<Json> texts;
+  EditorSession session(EditorConfig{.modes = 20, .cache_dir = cache},
+                        [&](bool binary, std::string data) {
+                          if (binary) return;
+                          std::lock_guard lock(mutex);
+                          texts.push_back(Json::parse(data));
+                          saved.notify_all();
+                        });
+  const auto open = [&] {
+    LoadedMesh mesh;
+    mesh.mesh = make_icosphere(3);
+    mesh.info = identity_read_info(mesh.mesh);
+    session.open(std::move(mesh), "sphere.obj");
+  };
+  open();
+  {
+    std::unique_lock lock(mutex);
+    const auto ready = std::find_if(texts.begin(), texts.end(),
+                                    [](const Json& j) { return j["type"] == "ready"; });
+    const auto saving = std::find_if(texts.begin(), texts.end(),
+                                     [](const Json& j) { return j["type"] == "saving"; });
+    ASSERT_LT(ready, saving);
+    EXPECT_FALSE((*saving)["done"]);
+    ASSERT_TRUE(saved.wait_for(lock, std::chrono::seconds(30), [&] {
+      return texts.back()["type"] == "saving" && texts.back()["done"];
+    }));
+    EXPECT_EQ(texts.back()["error"], "");
+    EXPECT_GT(texts.back()["bytes"], 0);
+    texts.clear();
+  }
+  open();
+  std::lock_guard lock(mutex);
+  const auto ready =
+      std::find_if(texts.begin(), texts.end(), [](const Json& j) { return j["type"] == "ready"; });
+  ASSERT_NE(ready, texts.end());
+  EXPECT_EQ((*ready)["basis"]["source"], "cache");
+  EXPECT_TRUE(std::none_of(texts.begin(), texts.end(),
+                           [](const Json& j) { return j["type"] == "saving"; }));
+  std::filesystem::remove_all(cache);
 }
 
 TEST(Preview, CoarsensToAboutTheTargetAndKeepsMeshVertices) {

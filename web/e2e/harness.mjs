@@ -2,10 +2,11 @@
 import { spawn } from 'node:child_process';
 import { chromium } from 'playwright-core';
 
-// Starts `BINARY edit --port PORT --no-cache ARGS...` (PORT 0: any free one); `url` resolves to
-// the address it prints, once it serves the page.
-export function startEditor(binary, editArgs = [], port = 0) {
-  const server = spawn(binary, ['edit', '--port', String(port), '--no-cache', ...editArgs], {
+// Starts `BINARY edit --port PORT --no-cache ARGS...` (PORT 0: any free one; `cacheDir`: that
+// basis cache instead of none); `url` resolves to the address it prints, once it serves the page.
+export function startEditor(binary, editArgs = [], port = 0, cacheDir = null) {
+  const cache = cacheDir ? ['--cache-dir', cacheDir] : ['--no-cache'];
+  const server = spawn(binary, ['edit', '--port', String(port), ...cache, ...editArgs], {
     stdio: ['ignore', 'pipe', 'inherit'],
   });
   const url = new Promise((resolveUrl, reject) => {

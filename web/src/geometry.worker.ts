@@ -21,6 +21,8 @@ export type WorkerReply =
       lookNormals: Float32Array | null; measures: Measures | null }
   | { kind: 'brush'; id: number; vertices: Uint32Array };
 
+// The brush's graph and the measures' rest lengths are made when first used, not before the
+// mesh's first frame (a second at a million vertices).
 interface Mesh {
   indices: Uint32Array;
   rest: Float32Array;
@@ -49,13 +51,7 @@ self.onmessage = (e: MessageEvent<WorkerRequest>) => {
     look = { vertex: m.vertex, group: m.group, indices: m.indices, sums: new Float32Array(3 * groups) };
   } else if (m.kind === 'mesh') {
     if (m.slot === 'full') look = null; // its look, if any, follows
-    meshes[m.slot] = {
-      indices: m.indices,
-      rest: m.rest,
-      brush: m.slot === 'full' ? new Brush(m.rest.length / 3, m.indices) : null,
-      measures: m.slot === 'full' ? new MeshMeasures(m.indices, m.rest) : null,
-      positions: m.rest.slice(),
-    };
+    meshes[m.slot] = { indices: m.indices, rest: m.rest, brush: null, measures: null, positions: m.rest.slice() };
   } else if (m.kind === 'frame') {
     const mesh = meshes[m.slot];
     if (!mesh || mesh.rest.length !== m.displacements.length) return;
@@ -70,12 +66,16 @@ self.onmessage = (e: MessageEvent<WorkerRequest>) => {
       groupNormals(positions, look.vertex, look.group, look.indices, look.sums, lookNormals);
     }
     const copy = positions.slice();
-    const measures = mesh.measures?.of(positions) ?? null;
+    // The rest shape has nothing to measure.
+    const moved = m.slot === 'full' && d.some((x) => x !== 0);
+    if (moved) mesh.measures ??= new MeshMeasures(mesh.indices, mesh.rest);
+    const measures = moved ? mesh.measures!.of(positions) : null;
     const transfer = lookNormals ? [copy.buffer, normals.buffer, lookNormals.buffer] : [copy.buffer, normals.buffer];
     post({ kind: 'frame', slot: m.slot, seq: m.seq, positions: copy, normals, lookNormals, measures }, transfer);
   } else {
     const mesh = meshes.full;
-    if (!mesh?.brush) return;
+    if (!mesh) return;
+    mesh.brush ??= new Brush(mesh.rest.length / 3, mesh.indices);
     const [x, y, z] = m.center;
     const vertices = m.geodesic
       ? mesh.brush.geodesic(mesh.positions, [m.vertex], m.radius)

@@ -4,8 +4,9 @@
 import * as THREE from 'three';
 import { Brush } from './brush';
 import { Point, corners, inPath, inRect, rectBetween, showRegion, verticesIn } from './boxselect';
+import { showGuides } from './guides';
 import { XMirror } from './mirror';
-import { EditorState, FIXED, FREE } from './state';
+import { EditorState, FIXED, FREE, stats } from './state';
 import { Mode, ModalTransform } from './transform';
 
 export type Tool = 'handle' | 'fixed' | 'erase' | 'move' | 'pin';
@@ -34,7 +35,6 @@ export class Interaction {
   private drag: Drag | null = null;
   private restTimer: number | undefined;
   private usedPreview = false;
-  private hoverQueued: { x: number; y: number } | null = null;
   private pointer = { x: 0, y: 0 }; // the last position over the view
   private cursorPress: { x: number; y: number } | null = null; // a Shift + right press
   pivotMode: PivotMode = 'median';
@@ -71,13 +71,15 @@ export class Interaction {
     const next = Math.min(10, Math.max(0.005, influence * (e.deltaY < 0 ? 1.15 : 1 / 1.15)));
     this.s.request({ type: 'settings', influence: next }, 'settings', 'ready');
     const region = `region of influence ${(100 * next).toFixed(1)}% of the diagonal`;
+    this.influence = next; // the circle follows at once, before the server's answer
+    this.showGuides();
     const modal = this.drag.modal;
     this.showHeader(modal ? `${modal.readout(this.pointer)} · ${region}` : region);
   }
 
   get radius(): number {
     const percent = Number((document.getElementById('radius') as HTMLInputElement).value);
-    return (percent / 100) * (this.s.ready?.diagonal ?? 1);
+    return (percent / 100) * this.s.diagonal;
   }
 
   private get geodesic(): boolean {
@@ -112,7 +114,7 @@ export class Interaction {
       this.pointer = { x: e.clientX, y: e.clientY };
       return this.selectTopology('linked');
     }
-    const lasso = e.button === 2 && e.ctrlKey && this.s.editable;
+    const lasso = e.button === 2 && e.ctrlKey && this.s.paintable;
     if (e.target === v.canvas && ((this.region.armed && e.button === 0) || lasso)) {
       e.stopPropagation();
       this.region = { armed: true, lasso, path: [{ x: e.clientX, y: e.clientY }] };
@@ -122,11 +124,12 @@ export class Interaction {
     // Only presses on the model's canvas: not on what lies over it (messages, dialogs).
     if (e.button !== 0 || e.target !== v.canvas) return; // right: orbit, middle: pan
     v.orbit.mouseButtons.LEFT = e.altKey ? THREE.MOUSE.ROTATE : null;
-    if (e.altKey || v.gizmo.axis !== null) return; // orbit, or the gizmo's own drag
+    if (e.altKey || this.gizmoTakes()) return; // orbit, or the gizmo's own drag
     e.stopPropagation();
-    if (!this.s.editable) {
+    if (!(this.tool === 'move' ? this.s.editable : this.s.paintable)) {
       this.s.note(this.s.phase.kind === 'disconnected' ? 'not connected: the edit waits for the server'
-        : 'the server is busy: wait for it to finish');
+        : this.s.paintable ? 'the basis is being computed: paint handles and fixed parts now, drag when it is ready'
+          : 'the server is busy: wait for it to finish');
       return;
     }
     const hit = v.pick(e.clientX, e.clientY);
@@ -164,28 +167,45 @@ export class Interaction {
     this.view.setPointerCapture(e.pointerId);
   }
 
+  // Pointer moves coalesce: the latest position is acted on once per animation frame, so that
+  // no event waits for a draw (a large mesh takes hundreds of milliseconds to draw without a GPU).
   private move(e: PointerEvent): void {
-    const v = this.s.viewer;
     this.pointer = { x: e.clientX, y: e.clientY };
+    const r = this.region;
+    if (r.lasso && r.path.length > 0) r.path.push({ ...this.pointer }); // every point of the lasso
+    this.moveButtons = e.buttons;
+    stats.pointerMoves++;
+    if (this.moveQueued) return;
+    this.moveQueued = true;
+    requestAnimationFrame(() => this.flushMove());
+  }
+  private moveQueued = false;
+  private moveButtons = 0;
+
+  // The last pointer move, if one waits (before a release acts on where the pointer is).
+  private flushMove(): void {
+    if (!this.moveQueued) return;
+    this.moveQueued = false;
+    stats.pointerActed++;
+    const v = this.s.viewer;
+    const { x, y } = this.pointer;
     if (this.drag?.modal) return this.modalMoved();
     const r = this.region;
-    if (r.path.length > 0) {
-      if (r.lasso) r.path.push({ ...this.pointer });
-      return showRegion(this.view, r.lasso ? r.path : corners(rectBetween(r.path[0], this.pointer)));
-    }
-    if (this.stroke) return this.paintAt(e.clientX, e.clientY);
+    if (r.path.length > 0) return showRegion(this.view, r.lasso ? r.path : corners(rectBetween(r.path[0], this.pointer)));
+    if (this.stroke) return this.paintAt(x, y);
     if (this.drag && !this.drag.pivot) {
-      const p = v.onViewPlane(e.clientX, e.clientY, this.drag.start);
+      const p = v.onViewPlane(x, y, this.drag.start);
       if (!p) return;
       const d = p.sub(this.drag.start);
       this.s.groups[this.drag.group].transform = new THREE.Matrix4().makeTranslation(d.x, d.y, d.z).multiply(this.drag.transform);
       this.dragged();
       return;
     }
-    if (this.tool !== 'move' && e.buttons === 0) this.hover(e.clientX, e.clientY);
+    if (this.tool !== 'move' && this.moveButtons === 0) this.hover(x, y);
   }
 
   private up(e: PointerEvent): void {
+    this.flushMove();
     const press = this.cursorPress;
     this.cursorPress = null;
     if (press && e.button === 2 && Math.hypot(e.clientX - press.x, e.clientY - press.y) < 5) this.placeCursor(e.clientX, e.clientY);
@@ -201,19 +221,9 @@ export class Interaction {
     if (this.drag && !this.drag.pivot) this.endDrag(true);
   }
 
-  // The brush circle follows the pointer, one pick per drawn frame.
+  // The brush circle follows the pointer.
   private hover(x: number, y: number): void {
-    if (this.hoverQueued) {
-      this.hoverQueued = { x, y };
-      return;
-    }
-    this.hoverQueued = { x, y };
-    requestAnimationFrame(() => {
-      const q = this.hoverQueued!;
-      this.hoverQueued = null;
-      if (this.tool === 'move' || this.stroke) return;
-      this.s.viewer.showBrush(this.s.editable ? this.s.viewer.pick(q.x, q.y) : null, this.radius);
-    });
+    this.s.viewer.showBrush(this.s.paintable ? this.s.viewer.pick(x, y) : null, this.radius);
   }
 
   // ------------------------------------------------------------ painting
@@ -275,7 +285,42 @@ export class Interaction {
       return;
     }
     this.s.sendSelection(stroke.pin !== null ? new Set([stroke.pin]) : new Set());
+    if (stroke.label >= 2 && stroke.pin === null && this.oneSided(stroke.label)) {
+      this.s.note('the handle covers only the side facing you: its centre is on the surface, not in the part, so turns ' +
+        'and scales shift it. Paint through with X-ray (Alt+Z, then B for a box), or orbit (right-drag) and paint around');
+    }
     this.s.changed();
+  }
+
+  // Whether the vertices labelled `label` (nearly all) face the camera while as many again face
+  // away right behind them (across the view, within their reach; along it, within 30% of the
+  // diagonal): one side of a thin part.
+  private oneSided(label: number): boolean {
+    const v = this.s.viewer;
+    const p = v.positions();
+    const nrm = v.normals();
+    const d = v.camera.getWorldDirection(new THREE.Vector3());
+    const facing = (k: number) => nrm[3 * k] * d.x + nrm[3 * k + 1] * d.y + nrm[3 * k + 2] * d.z;
+    const members: number[] = [];
+    this.s.labels.forEach((l, k) => l === label && members.push(k));
+    if (members.length === 0 || members.filter((k) => facing(k) > 0.1).length > 0.1 * members.length) return false;
+    const c = new THREE.Vector3();
+    for (const k of members) c.add(new THREE.Vector3().fromArray(p, 3 * k));
+    c.divideScalar(members.length);
+    const q = new THREE.Vector3();
+    const offset = (k: number) => {
+      q.fromArray(p, 3 * k).sub(c);
+      const along = q.dot(d);
+      return { along, across: q.addScaledVector(d, -along).length() };
+    };
+    const reach = Math.max(...members.map((k) => offset(k).across));
+    let behind = 0;
+    this.s.labels.forEach((l, k) => {
+      if (l === label || facing(k) < 0.3) return;
+      const o = offset(k);
+      if (o.across < reach && o.along > 0 && o.along < 0.3 * this.s.diagonal) ++behind;
+    });
+    return behind > 0.5 * members.length;
   }
 
   // A new handle group (a pin: held where it is shown); returns its index.
@@ -301,7 +346,8 @@ export class Interaction {
   // ------------------------------------------------------------ dragging
 
   private dragged(): void {
-    if (this.drag) this.xMirror.follow(this.s.groups, this.drag.group);
+    if (this.drag) this.xMirror.follow(this.s, this.drag.group);
+    this.showGuides();
     const preview = this.s.previewWanted;
     this.usedPreview ||= preview;
     this.s.sendFrame(preview);
@@ -343,11 +389,25 @@ export class Interaction {
       this.s.groups[d.group].transform = d.transform;
       for (const o of d.others ?? []) this.s.groups[o.group].transform = o.transform;
     }
-    this.xMirror.follow(this.s.groups, d.group);
+    this.xMirror.follow(this.s, d.group);
+    this.influence = null;
+    this.showGuides();
     if (this.usedPreview || !keep) this.s.sendFrame(false);
     if (keep) this.s.commit();
     this.placeGizmo();
     this.s.changed();
+  }
+
+  // The pivot's mark, with a dashed line to the pointer while turning or scaling, and the region
+  // of influence's circle, during a move.
+  private influence: number | null = null; // the region's radius asked for with the wheel
+  private showGuides(): void {
+    const d = this.drag;
+    const influence = (this.influence ?? this.s.ready?.settings.influence ?? 0) * this.s.diagonal;
+    const turning = d?.modal && d.modal.mode !== 'grab';
+    const pivot = d ? (d.modal ? d.start : this.pivotPoint()) : null;
+    showGuides(this.s.viewer, this.view, d && pivot && (turning || influence > 0)
+      ? { pivot, pointer: turning ? this.pointer : null, influence } : null);
   }
 
   // The active group's centroid at rest (null if it has no vertices).
@@ -401,6 +461,19 @@ export class Interaction {
     const overlay = document.getElementById('overlay')!.getBoundingClientRect();
     const top = Math.max(r.top, overlay.bottom) + 90;
     return new DOMRect(r.left + 110, top, Math.max(0, r.width - 220), Math.max(0, r.bottom - 120 - top));
+  }
+
+  // Whether a press goes to the gizmo: one of its parts is under the pointer, but not an arrow
+  // pointing nearly along the view (its picker then covers the handle around the pivot: a
+  // press there moves the handle in the view plane).
+  private gizmoTakes(): boolean {
+    const v = this.s.viewer;
+    const axis = v.gizmo.axis;
+    if (axis === null) return false;
+    const k = ['X', 'Y', 'Z'].indexOf(axis);
+    if (k < 0 || v.gizmo.mode !== 'translate') return true;
+    const view = v.camera.getWorldDirection(new THREE.Vector3());
+    return Math.abs(view.getComponent(k)) < 0.8;
   }
 
   private nearGizmo(x: number, y: number): boolean {
@@ -495,14 +568,14 @@ export class Interaction {
 
   // The Linked button: the next left click selects the piece under it (L does it at once).
   armLinked(): void {
-    if (!this.s.editable || this.stroke || this.drag) return;
+    if (!this.s.paintable || this.stroke || this.drag) return;
     this.linkedArmed = true;
     this.showHeader('Select linked: click the piece to select; Esc cancels');
   }
 
   // B: the next left drag draws a rectangle; its vertices get the tool's label.
   armBox(): void {
-    if (!this.s.editable || this.stroke || this.drag) return;
+    if (!this.s.paintable || this.stroke || this.drag) return;
     this.region = { armed: true, lasso: false, path: [] };
     this.showHeader(`Box select (${this.xray ? 'X-ray: through the surface' : 'visible vertices only'}): ` +
       'drag a rectangle with the left button; Esc cancels');
@@ -520,7 +593,7 @@ export class Interaction {
       this.s.note('Pin paints one pinned region per stroke: pick Handle, Fixed or Erase');
       return true;
     }
-    this.relabel(verticesIn(this.s.viewer, contains, this.xray, this.s.ready?.diagonal ?? 1), () => label, label);
+    this.relabel(verticesIn(this.s.viewer, contains, this.xray, this.s.diagonal), () => label, label);
     return true;
   }
 
@@ -537,7 +610,7 @@ export class Interaction {
   // grow / shrink: by one ring of neighbours. One undo step each.
   selectTopology(op: 'linked' | 'invert' | 'grow' | 'shrink'): void {
     const s = this.s;
-    if (!s.editable || this.stroke || this.drag) return;
+    if (!s.paintable || this.stroke || this.drag) return;
     const label = this.toolLabel();
     if (label === null) return s.note('Pin paints one pinned region per stroke: pick Handle, Fixed or Erase');
     const labels = s.labels;

@@ -23,13 +23,21 @@ const viewer = state.viewer;
   get phase() {
     return state.phase.kind;
   },
+  get paintable() {
+    return state.paintable;
+  },
+  // The server's counts of the edit ("state"): what it applied of the page's selection.
+  serverCounts: () => state.server && {
+    handles: state.server.groups.reduce((a, g) => a + g.vertices, 0),
+    fixed: state.server.fixed,
+  },
   stats,
   restPositions: () => Array.from(state.rest),
   positions: () => Array.from(viewer.positions()),
   labels: () => Array.from(state.labels),
   transforms: () => state.groups.map((g) => rowMajor(g.transform)),
   vertexOnScreen: (v: number) => viewer.toScreen(new THREE.Vector3().fromArray(viewer.positions(), 3 * v)),
-  diagonal: () => state.ready?.diagonal ?? 1,
+  diagonal: () => state.diagonal,
   settled: () => state.settled(),
   previewSize: () => (state.previewWanted ? viewer.previewSize : 0),
   notes: () => state.notes.map((n) => ({ ...n })),

@@ -3,7 +3,7 @@
 // exact on symmetric meshes, near on scanned ones; none where nothing is near), and a handle group's transform mirrored for
 // its counterpart group; XMirror, the editor's switch, pairs the groups.
 import * as THREE from 'three';
-import type { EditorState, Group } from './state';
+import type { EditorState } from './state';
 
 export interface Mirror {
   flip: THREE.Matrix4; // the reflection x -> 2c - x
@@ -50,16 +50,43 @@ export function mirror(rest: Float32Array, diagonal: number): Mirror {
 }
 
 // The X mirror of painting and moves: a painted handle's counterparts go to a group of their
-// own (made on first use, paired in this page only), which moves mirrored.
+// own (made on first use), which moves mirrored. The switch and the pairing are kept in the
+// tab's session storage, by mesh: a reload keeps them.
 export class XMirror {
-  on = false;
+  private switched = false;
   private symmetry: { rest: Float32Array; mirror: Mirror } | null = null;
   private partner = new Map<number, number>(); // handle group -> its mirror image's group
+  private key: string | null = null; // of the session storage
+
+  get on(): boolean {
+    return this.switched;
+  }
+
+  set on(on: boolean) {
+    this.switched = on;
+    this.save();
+  }
+
+  // The switch and pairing kept for `mesh` (a name for the mesh open).
+  restore(mesh: string): void {
+    this.key = `specdeform-x-mirror:${mesh}`;
+    const saved = JSON.parse(sessionStorage.getItem(this.key) ?? 'null') as { on: boolean; pairs: [number, number][] } | null;
+    this.switched = saved?.on ?? false;
+    this.partner = new Map(saved?.pairs ?? []);
+  }
+
+  private save(): void {
+    if (this.key) sessionStorage.setItem(this.key, JSON.stringify({ on: this.switched, pairs: [...this.partner] }));
+  }
+
+  private mirrorOf(s: EditorState): Mirror {
+    if (this.symmetry?.rest !== s.rest) this.symmetry = { rest: s.rest, mirror: mirror(s.rest, s.diagonal) };
+    return this.symmetry.mirror;
+  }
 
   // The counterparts of painted vertices with the label each gets.
   paired(s: EditorState, vertices: Uint32Array, label: number): [number, number][] {
-    if (this.symmetry?.rest !== s.rest) this.symmetry = { rest: s.rest, mirror: mirror(s.rest, s.ready?.diagonal ?? 1) };
-    const m = this.symmetry.mirror;
+    const m = this.mirrorOf(s);
     let target = label;
     if (label >= 2) {
       const g = label - 2;
@@ -69,6 +96,7 @@ export class XMirror {
         p = s.groups.length - 1;
         this.partner.set(g, p);
         this.partner.set(p, g);
+        this.save();
       }
       target = 2 + p;
     }
@@ -78,8 +106,9 @@ export class XMirror {
   }
 
   // Group g's counterpart takes the mirror image of its transform.
-  follow(groups: Group[], g: number): void {
+  follow(s: EditorState, g: number): void {
     const p = this.partner.get(g);
-    if (this.on && p !== undefined && groups[p] && this.symmetry) groups[p].transform = mirrored(groups[g].transform, this.symmetry.mirror);
+    const groups = s.groups;
+    if (this.on && p !== undefined && groups[p]) groups[p].transform = mirrored(groups[g].transform, this.mirrorOf(s));
   }
 }

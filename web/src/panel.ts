@@ -20,9 +20,15 @@ const HINTS: Record<Tool, string> = {
 
 const MESH_FILE = /\.(obj|off|ply|stl|gltf|glb)$/i;
 
+// A loading stage, with its fraction when it has one (a stage without one is reported as 1).
+function progressText(phase: { stage: string; fraction: number }): string {
+  return phase.fraction < 1 ? `${phase.stage}… ${Math.round(100 * phase.fraction)}%` : `${phase.stage}…`;
+}
+
 export class Panel {
   private shownNotes = 0; // notes already turned into toasts
   private lastPhase = '';
+  private mirrorMesh: string | null = null; // the mesh whose X-mirror pairing is in use
   private transientToasts: HTMLElement[] = []; // removed when the request ends
 
   constructor(private readonly s: EditorState, private readonly ui: Interaction) {
@@ -237,6 +243,12 @@ export class Panel {
     const s = this.s;
     const ctrl = e.ctrlKey || e.metaKey;
     const views: Record<string, [number, number, number]> = { Numpad1: [0, 0, 1], Numpad3: [1, 0, 0], Numpad7: [0, 1, 0] };
+    // Disconnected, only the view keys act.
+    const viewKey = views[e.code] !== undefined || e.code === 'NumpadDecimal' || e.key === 'Home' || e.key === 'Escape';
+    if (s.phase.kind === 'disconnected' && !viewKey) {
+      if (e.key.length === 1) s.note(`"${e.key}" does nothing while disconnected: the edit waits for the server`);
+      return;
+    }
     const tools: Record<string, Tool> = { Digit1: 'handle', Digit2: 'fixed', Digit3: 'erase', Digit4: 'move', Digit5: 'pin' };
     if (views[e.code]) {
       e.preventDefault();
@@ -291,16 +303,17 @@ export class Panel {
         case 'connecting': return ['Connecting to the server…', 'busy'];
         case 'disconnected': return ['Disconnected — edits are paused', 'down'];
         case 'empty': return ['No mesh is open: open one (Open mesh…, or drop a file) or the Demo', 'busy'];
-        case 'loading': return [`${phase.stage}… ${Math.round(100 * phase.fraction)}%`, 'busy'];
+        case 'loading': return [`${progressText(phase)}${s.preparing ? ' · paint handles and fixed parts meanwhile' : ''}`, 'busy'];
         case 'busy': return [`${phase.what}: waiting for the server…`, 'busy'];
         case 'ready': return s.server?.detail_pending
           ? [`${r ? `${r.name}: ` : ''}working: factoring the transfer's details (displacements until then)`, 'busy']
-          : [r ? `${r.name}: ready` : 'ready', 'ready'];
+          : s.saving ? [`${r ? `${r.name}: ` : ''}ready · saving the basis for next time`, 'ready']
+            : [r ? `${r.name}: ready` : 'ready', 'ready'];
       }
     })();
     status.textContent = text;
     status.className = cls;
-    $('hint').textContent = editable ? this.nextStep() : '';
+    $('hint').textContent = s.paintable ? this.nextStep() : '';
     const c = s.counts();
     $('counts').textContent = r && editable
       ? `handles: ${c.handles.toLocaleString()} vertices in ${c.groups} group${c.groups === 1 ? '' : 's'} · ` +
@@ -314,8 +327,9 @@ export class Panel {
     // Progress with Cancel.
     const loading = phase.kind === 'loading';
     $('progress').hidden = !loading;
+    $('progress').classList.toggle('aside', s.preparing); // the mesh it prepares is painted meanwhile
     if (loading) {
-      $('progress-stage').textContent = `${phase.stage}… ${Math.round(100 * phase.fraction)}%`;
+      $('progress-stage').textContent = progressText(phase);
       $<HTMLProgressElement>('progress-bar').value = phase.fraction;
       $<HTMLButtonElement>('cancel').hidden = !phase.cancellable;
     } else {
@@ -346,7 +360,7 @@ export class Panel {
     $('pose').textContent = r && r.pose > 0 ? `pose ${r.pose} applied` : '';
     document.querySelectorAll<HTMLButtonElement>('[data-tool]').forEach((b) => {
       b.setAttribute('aria-checked', String(b.dataset.tool === this.ui.tool));
-      b.disabled = !editable;
+      b.disabled = !(b.dataset.tool === 'move' ? editable : s.paintable);
     });
     const select = $<HTMLSelectElement>('group');
     const groups = s.groups.map((g, k) => ({ g, k })).filter(({ g }) => !g.pinned);
@@ -355,6 +369,12 @@ export class Panel {
     select.style.color = `#${(active?.pinned ? PIN_HEX : GROUP_HEX[s.activeGroup % GROUP_HEX.length]).toString(16).padStart(6, '0')}`;
     $('radius-value').textContent = `${$<HTMLInputElement>('radius').value}% of the diagonal`;
     if (phase.kind !== this.lastPhase && (phase.kind === 'ready' || phase.kind === 'empty')) this.renderFields();
+    const mesh = r ? `${r.name}:${r.vertices}:${r.faces}` : null;
+    if (mesh && mesh !== this.mirrorMesh) {
+      this.mirrorMesh = mesh;
+      this.ui.xMirror.restore(mesh);
+      $<HTMLInputElement>('x-mirror').checked = this.ui.xMirror.on;
+    }
     if (phase.kind !== 'busy') this.transientToasts.splice(0).forEach((t) => t.remove());
     this.lastPhase = phase.kind;
     if (!connected || !editable) s.viewer.gizmo.detach();
@@ -472,7 +492,8 @@ export class Panel {
     const median = (v: number[]) => (v.length ? [...v].sort((a, b) => a - b)[Math.floor(v.length / 2)] : NaN);
     const rows: [string, string][] = [
       ['basis', r ? `${r.basis.seconds.toFixed(2)} s (${r.basis.source}, m = ${r.modes}${
-        r.basis.approximate ? `, approximate: multilevel, residual ${r.basis.residual.toPrecision(2)}` : ''})` : '–'],
+        r.basis.approximate ? `, approximate: multilevel; its modes are only close to the true frequencies ` +
+          `(residual ${r.basis.residual.toPrecision(2)}: how far each is from an exact eigenvector, relative to its frequency)` : ''})` : '–'],
       ['selection', s.server ? `${(1000 * s.server.selection_seconds).toFixed(1)} ms` : '–'],
       ['solve (server)', f ? `${f.ms.total.toFixed(1)} ms` : '–'],
       ['· reduced / inverse / detail', f

@@ -42,10 +42,11 @@ export interface Settings {
 
 // ---------------------------------------------------------------- JSON, server -> browser
 
+// While a basis is prepared; a mesh being opened is sent before its first one (drawn, painted).
 export interface ProgressMessage {
   type: 'progress';
   stage: string;
-  fraction: number;
+  fraction: number; // 1 for a stage without a fraction of its own ("setting up the solver")
   cancellable: boolean;
 }
 
@@ -98,7 +99,10 @@ export type ServerText =
   | StateMessage
   | ErrorMessage
   | { type: 'empty'; request: string }
-  | { type: 'note'; message: string }; // what an export dropped or changed
+  | { type: 'note'; message: string } // what an export dropped or changed
+  // The basis just computed, written to the cache in the background (after "ready"): once when
+  // it starts, once when it is done (with its size and time, or the error).
+  | { type: 'saving'; file: string; done: boolean; seconds?: number; bytes?: number; error?: string };
 
 // ---------------------------------------------------------------- JSON, browser -> server
 

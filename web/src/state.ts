@@ -37,6 +37,9 @@ export const stats = {
   latencies: [] as number[], // mouse event to its frame drawn (ms)
   receiveLatencies: [] as number[], // to its result received
   drawTimes: [] as number[],
+  meshDrawn: null as number | null, // performance.now() when the last new mesh was first drawn
+  pointerMoves: 0, // pointer moves over the view, and how many of them were acted on (coalesced)
+  pointerActed: 0,
 };
 
 // Draws slower than this (ms, measured once per mesh) make drags show the preview mesh, sized
@@ -58,6 +61,13 @@ export class EditorState {
   measures: Measures | null = null; // of the full frame shown
   notes: Note[] = [];
   drawMs = 0; // the full mesh's draw time
+  diagonal = 1; // of the mesh's bounding box
+  // The mesh on screen is being prepared (its basis computed): it can be painted, and the
+  // selection is held until it is ready.
+  preparing = false;
+  saving: string | null = null; // the basis file the server writes in the background
+  private selectionHeld = false; // painted while preparing: sent when the mesh is ready
+  private firstDraw: 'none' | 'shown' | 'drawn' = 'drawn'; // of a new mesh
   previewWanted = false;
   private preview: P.PreviewMessage | null = null; // the coarse mesh of drags
   painting = false; // a brush stroke is on (interaction.ts)
@@ -105,6 +115,12 @@ export class EditorState {
     return this.phase.kind === 'ready';
   }
 
+  // Handles and fixed parts can be painted: the mesh is ready, or on screen while its basis
+  // is computed.
+  get paintable(): boolean {
+    return this.editable || (this.preparing && this.phase.kind === 'loading');
+  }
+
   // Messages for the user: errors stay until dismissed (panel.ts), the last 30 are kept.
   note(text: string, level: Note['level'] = 'info', transient = false): void {
     if (!text) return;
@@ -135,6 +151,10 @@ export class EditorState {
   // Strokes coalesce: a plain selection made while another is on its way waits, and only the
   // newest goes when the server answers (no queue of rebuilds behind the pointer).
   sendSelection(fit: Set<number> = new Set(), echo = false): void {
+    if (this.preparing) {
+      this.selectionHeld = true;
+      return;
+    }
     if (fit.size === 0 && !echo && this.selectionsInFlight > 0) {
       this.selectionWaiting = true;
       return;
@@ -202,7 +222,7 @@ export class EditorState {
   settled(): boolean {
     return this.outstanding === null && this.pendingDraw === null && this.awaitingStates === 0 &&
       !this.selectionWaiting && !this.server?.detail_pending && !this.painting &&
-      !this.normalsBusy.full && this.phase.kind !== 'busy';
+      !this.normalsBusy.full && this.phase.kind !== 'busy' && !this.selectionHeld && this.selectionsInFlight === 0;
   }
 
   // The vertices a brush stroke reaches (computed by the worker).
@@ -252,6 +272,14 @@ export class EditorState {
         break;
       case 'note':
         this.note(m.message);
+        break;
+      case 'saving':
+        this.saving = m.done ? null : m.file;
+        if (m.done) {
+          this.note(m.error ? `the basis was not saved for next time: ${m.error}`
+            : `saved the basis for next time (${((m.bytes ?? 0) / 1e6).toFixed(0)} MB in ${(m.seconds ?? 0).toFixed(1)} s)`,
+          m.error ? 'error' : 'info');
+        }
         break;
       case 'empty':
         if (STATE_REQUESTS.has(m.request)) this.awaitingStates = Math.max(0, this.awaitingStates - 1);
@@ -343,6 +371,7 @@ export class EditorState {
     }
     this.normalsBusy[m.slot] = false;
     const newer = m.slot === 'full' || !this.fullAfter(m.seq);
+    if (m.slot === 'full' && this.firstDraw === 'none') this.firstDraw = 'shown';
     if (m.slot === 'full') {
       this.viewer.setPositions(m.positions, m.normals, m.lookNormals);
       this.measures = m.measures;
@@ -372,6 +401,11 @@ export class EditorState {
   }
 
   private onRendered(): void {
+    if (this.firstDraw === 'shown') {
+      this.firstDraw = 'drawn';
+      stats.meshDrawn = performance.now();
+      setTimeout(() => this.choosePreview()); // measured once it is on screen
+    }
     if (this.pendingDraw === null) return;
     const t = this.sentAt.get(this.pendingDraw);
     const now = performance.now();
@@ -396,7 +430,8 @@ export class EditorState {
     this.showRest();
     if (sameTriangles && this.preview) this.postPreview(this.preview); // another pose
     if (!sameTriangles) {
-      // Another mesh: the selection goes (the server says so too), the preview is measured again.
+      // Another mesh: the selection goes (the server says so too), the preview is measured again
+      // once it is drawn. It is painted while its basis is computed.
       this.indices = m.indices.slice();
       this.labels = new Int16Array(n);
       this.groups = [{ transform: new THREE.Matrix4(), pinned: false }];
@@ -404,6 +439,10 @@ export class EditorState {
       this.previewWanted = false;
       this.preview = null;
       this.drawMs = 0;
+      this.diagonal = diagonalOf(this.rest);
+      this.preparing = true;
+      this.selectionHeld = false;
+      this.firstDraw = 'none';
       this.paint();
     }
   }
@@ -416,30 +455,43 @@ export class EditorState {
       this.restoreSettings = { type: 'settings', modes: previous.modes, ...previous.settings };
     }
     this.ready = m;
+    this.preparing = false;
     if (previous?.settings.influence !== m.settings.influence) this.paint();
     if (m.basis.warning) this.note(m.basis.warning, 'error');
-    if (newMesh) requestAnimationFrame(() => this.choosePreview());
   }
 
   // Measures the full mesh's draw once; if it is too slow for drags, asks for a preview that
   // draws in about kPreviewMs.
   private choosePreview(): void {
-    if (!this.ready || this.rest.length === 0) return;
+    if (this.rest.length === 0) return;
     this.drawMs = this.viewer.measureDraw();
     const n = this.rest.length / 3;
     const wanted = this.drawMs > kFullDrawBudgetMs;
     const size = Math.round(Math.max(2000, Math.min(n / 3, (n * kPreviewMs) / this.drawMs)));
     this.previewWanted = wanted;
-    if (wanted && this.viewer.previewSize !== size) this.connection.send({ type: 'preview', vertices: size });
+    if (wanted && this.viewer.previewSize !== size) this.previewRequest = { type: 'preview', vertices: size };
+    if (!this.preparing) this.sendPreviewRequest();
     this.changed();
   }
 
+  // The server sets the preview's deformer up (seconds at a million vertices) after the
+  // selection painted while the mesh was prepared, not before it.
+  private sendPreviewRequest(): void {
+    if (this.previewRequest) this.connection.send(this.previewRequest);
+    this.previewRequest = null;
+  }
+  private previewRequest: P.ClientText | null = null;
+
   private adoptSelection(s: P.Selection): void {
     const empty = s.groups.length === 0 && s.fixed.length === 0;
+    if (this.selectionHeld && empty) return; // the new mesh's: what was painted meanwhile stays
     if (this.restorePending) {
       if (empty) return; // an earlier reply: the restored selection follows
       this.restorePending = false;
     }
+    // A reply to a request sent before the selection on its way (the "hello" of a page that
+    // painted while the basis was computed): that selection is newer.
+    if (this.selectionsInFlight > 0) return;
     if (!this.restoreChecked && empty && this.labels.some((l) => l !== FREE)) {
       this.restoring = true; // decided on the "state" that follows
       return;
@@ -465,6 +517,11 @@ export class EditorState {
   private adoptState(m: P.StateMessage): void {
     if (STATE_REQUESTS.has(m.request)) this.awaitingStates = Math.max(0, this.awaitingStates - 1);
     if (m.request === 'selection') this.selectionAnswered();
+    if (this.selectionHeld && !this.preparing) {
+      this.selectionHeld = false;
+      this.sendSelection();
+    }
+    if (!this.preparing) this.sendPreviewRequest();
     if (!this.restoreChecked) {
       this.restoreChecked = true;
       const restarted = m.groups.length === 0 && m.fixed === 0 && !m.undo;
@@ -511,7 +568,7 @@ export class EditorState {
   // Free vertices that the region of influence holds (the server's rule, for drawing): beyond
   // its radius from every handle vertex, along the edges; null when there is no region.
   private heldByInfluence(): Uint8Array | null {
-    const radius = (this.ready?.settings.influence ?? 0) * (this.ready?.diagonal ?? 1);
+    const radius = (this.ready?.settings.influence ?? 0) * this.diagonal;
     const handles: number[] = [];
     this.labels.forEach((l, v) => l >= 2 && handles.push(v));
     this.influenceHeld = 0;
@@ -555,6 +612,15 @@ const FIXED_COLOR = new THREE.Color(0x4e79a7);
 const HELD_COLOR = new THREE.Color(0x9a9aa3); // held by the region of influence: grey, darker than free
 export const PIN_HEX = 0x1f3b63;
 const PIN_COLOR = new THREE.Color(PIN_HEX);
+
+function diagonalOf(p: Float32Array): number {
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < p.length; ++i) {
+    lo[i % 3] = Math.min(lo[i % 3], p[i]);
+    hi[i % 3] = Math.max(hi[i % 3], p[i]);
+  }
+  return Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
+}
 
 export function rowMajor(m: THREE.Matrix4): P.Matrix {
   return m.clone().transpose().toArray();

@@ -126,7 +126,7 @@ export class Viewer {
     }
     this.geometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
     this.geometry.computeBoundingSphere();
-    this.bvh = new MeshBVH(this.geometry);
+    this.bvh = null; // built after the first draw (seconds for a million triangles)
     this.bvhStale = false;
     this.coarse.visible = false;
     if (!keepCamera) this.look.set(null); // another mesh: its look, if any, follows
@@ -145,6 +145,10 @@ export class Viewer {
 
   positions(): Float32Array {
     return this.geometry.getAttribute('position').array as Float32Array;
+  }
+
+  normals(): Float32Array {
+    return this.geometry.getAttribute('normal').array as Float32Array;
   }
 
   // The file's look (after its mesh), or none.
@@ -292,7 +296,8 @@ export class Viewer {
   }
 
   pick(clientX: number, clientY: number): Hit | null {
-    if (!this.bvh) return null;
+    if (!this.geometry.index) return null;
+    this.bvh ??= new MeshBVH(this.geometry);
     if (this.bvhStale) {
       this.bvh.refit();
       this.bvhStale = false;
@@ -397,27 +402,40 @@ export class Viewer {
     this.coarse.visible = false;
     this.surface.visible = true;
     draw();
+    // The median of three, or one draw when it is slow enough to decide (each blocks the page).
     const times: number[] = [];
-    for (let i = 0; i < 3; ++i) {
+    for (let i = 0; i < 3 && !(times[0] > 4 * kSlowDrawMs); ++i) {
       const t = performance.now();
       draw();
       times.push(performance.now() - t);
     }
     this.coarse.visible = coarse;
     this.surface.visible = !coarse;
-    return times.sort((a, b) => a - b)[1];
+    this.drawMs = times.sort((a, b) => a - b)[Math.floor(times.length / 2)];
+    return this.drawMs;
   }
 
+  // Draws on the next animation frame. A slow draw (the full large mesh without a GPU) is
+  // followed by as long without one, so that pointer events, which wait for the frame being drawn, still
+  // come in at once half of the time.
   requestRender(): void {
     if (this.renderQueued) return;
     this.renderQueued = true;
-    requestAnimationFrame(() => {
+    const draw = () => requestAnimationFrame(() => {
       this.renderQueued = false;
       this.renderer.render(this.scene, this.camera);
+      this.lastDraw = performance.now();
       this.drawAxes();
       this.onRendered();
+      if (!this.bvh && this.geometry.index) setTimeout(() => (this.bvh ??= new MeshBVH(this.geometry)));
     });
+    const slow = this.drawMs > kSlowDrawMs && !this.coarse.visible; // the preview draws fast
+    const wait = slow ? this.lastDraw + this.drawMs - performance.now() : 0;
+    if (wait > 0) setTimeout(draw, wait);
+    else draw();
   }
+  drawMs = 0; // the full mesh's draw, measured by measureDraw
+  private lastDraw = -Infinity;
 
   // The axis widget: the world axes as the camera sees them, +X red, +Y green, +Z blue.
   private axisEnds(): { axis: THREE.Vector3; x: number; y: number; depth: number; label: string; color: string }[] {
@@ -480,6 +498,9 @@ export class Viewer {
     this.requestRender();
   }
 }
+
+// Draws slower than this are spaced out (requestRender).
+const kSlowDrawMs = 50;
 
 function softwareRenderer(): boolean {
   const gl = document.createElement('canvas').getContext('webgl2');
