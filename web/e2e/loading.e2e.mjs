@@ -137,10 +137,13 @@ try {
   log(`painted ${painted.handles} handle and ${painted.fixed} fixed vertices at ${(painted.at / 1000).toFixed(2)} s, phase ${painted.phase}`);
   check(painted.handles > 0 && painted.fixed > 0, `a handle and a fixed part were painted (${JSON.stringify(painted)})`);
   // The first drag waits only for the basis and the selection (not the transfer's details).
-  await page.waitForFunction(() => {
+  // (When the basis is ready before the fixed part is painted, the two strokes reach the server
+  // one after the other: wait for both.)
+  await page.waitForFunction((p) => {
     const e = window.specdeformEditor;
-    return e.ready && e.serverCounts()?.handles > 0;
-  }, null, { timeout: 300000 });
+    const c = e.serverCounts();
+    return e.ready && c?.handles === p.handles && c?.fixed === p.fixed;
+  }, painted, { timeout: 300000 }).catch(() => {});
   result.selection_applied_s = (await now()) / 1000;
   result.ready_s = (await api(() => window.statusLog.find((s) => /: ready/.test(s.text))?.t ?? performance.now())) / 1000;
   const applied = await api(() => window.specdeformEditor.serverCounts());
