@@ -11,7 +11,7 @@ import { mkdirSync } from 'node:fs';
 import { dirname, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { parseArgs } from 'node:util';
-import { launchChromium, startEditor } from './harness.mjs';
+import { check, launchChromium, log, startEditor } from './harness.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const { values: args } = parseArgs({
@@ -22,10 +22,6 @@ const { values: args } = parseArgs({
     chromium: { type: 'string', default: process.env.CHROMIUM ?? '/usr/bin/chromium' },
   },
 });
-const log = (...a) => console.error('e2e:', ...a);
-function check(condition, message) {
-  if (!condition) throw new Error(`check failed: ${message}`);
-}
 
 const editor = startEditor(args.binary, ['--eigensolver', 'multilevel', '-m', '30']);
 const url = await editor.url;

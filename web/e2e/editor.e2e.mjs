@@ -28,7 +28,7 @@ import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { basename, dirname, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { parseArgs } from 'node:util';
-import { launchChromium, startEditor } from './harness.mjs';
+import { check, launchChromium, log, startEditor } from './harness.mjs';
 import { writeTexturedGlb, writeTexturedObj } from './textured.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
@@ -44,11 +44,6 @@ const { values: args } = parseArgs({
   },
 });
 const meshArgs = args.mesh ? [args.mesh] : [];
-const log = (...a) => console.error('e2e:', ...a);
-
-function check(condition, message) {
-  if (!condition) throw new Error(`check failed: ${message}`);
-}
 
 const percentile = (values, p) => {
   const s = [...values].sort((a, b) => a - b);

@@ -26,3 +26,11 @@ export function launchChromium(executablePath = process.env.CHROMIUM ?? '/usr/bi
     args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox'],
   });
 }
+
+// One line of the test's progress on stderr.
+export const log = (...a) => console.error('e2e:', ...a);
+
+// Throws, naming what failed, unless `condition` holds.
+export function check(condition, message) {
+  if (!condition) throw new Error(`check failed: ${message}`);
+}

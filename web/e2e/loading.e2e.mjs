@@ -19,7 +19,7 @@ import { tmpdir } from 'node:os';
 import { basename, dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { parseArgs } from 'node:util';
-import { launchChromium, startEditor } from './harness.mjs';
+import { check, launchChromium, log, startEditor } from './harness.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const { values: args } = parseArgs({
@@ -31,10 +31,6 @@ const { values: args } = parseArgs({
     chromium: { type: 'string', default: process.env.CHROMIUM ?? '/usr/bin/chromium' },
   },
 });
-const log = (...a) => console.error('e2e:', ...a);
-function check(condition, message) {
-  if (!condition) throw new Error(`check failed: ${message}`);
-}
 
 const cacheDir = mkdtempSync(join(tmpdir(), 'specdeform-cache-'));
 const editArgs = [...(args.mesh ? [args.mesh] : []), ...(args.modes ? ['-m', args.modes] : [])];
