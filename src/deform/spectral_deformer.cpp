@@ -46,6 +46,18 @@ Eigen::MatrixXd linear_hessian(const TriangleMesh& mesh, const ManifoldHarmonics
              detail::reduced_bending(S, area, basis.basis, basis.mass == MassType::Lumped);
 }
 
+// Each column's piece: the piece of its largest entry (a basis of several pieces is computed
+// piece by piece, each mode on one).
+std::vector<int> piece_of_columns(const Eigen::MatrixXd& H, const Eigen::VectorXi& components) {
+  std::vector<int> out(H.cols());
+  for (Eigen::Index j = 0; j < H.cols(); ++j) {
+    Eigen::Index i;
+    H.col(j).cwiseAbs().maxCoeff(&i);
+    out[j] = components[i];
+  }
+  return out;
+}
+
 }  // namespace
 
 SpectralDeformer::SpectralDeformer(TriangleMesh mesh, ManifoldHarmonics basis,
@@ -70,14 +82,8 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
   Clock clock;
   components_ = vertex_components(mesh_, &num_components_);
   if (has_basis) {
-    // A mode's piece: the piece of its largest entry (a basis of several pieces is computed
-    // piece by piece, each mode on one).
-    piece_of_mode_.assign(basis_->basis.cols(), 0);
-    for (Eigen::Index j = 0; j < basis_->basis.cols() && num_components_ > 1; ++j) {
-      Eigen::Index i;
-      basis_->basis.col(j).cwiseAbs().maxCoeff(&i);
-      piece_of_mode_[j] = components_[i];
-    }
+    piece_of_mode_ = num_components_ > 1 ? piece_of_columns(basis_->basis, components_)
+                                         : std::vector<int>(basis_->basis.cols(), 0);
     const Eigen::MatrixXd& H = basis_->basis;
     base_ = harmonics_inverse(H, harmonics_forward(H, mass_matrix(mesh_, basis_->mass), mesh_.V));
   } else {
@@ -106,15 +112,9 @@ void SpectralDeformer::build_solvers(std::shared_ptr<const ManifoldHarmonics> ba
   const bool spectral = options_.solver == DeformSolver::Spectral;
   solve_basis_ = std::move(basis);
   solve_piece_modes_.assign(num_components_, 0);
-  if (solve_basis_ == basis_) {
-    for (const int c : piece_of_mode_) ++solve_piece_modes_[c];
-  } else {
-    for (Eigen::Index j = 0; j < solve_basis_->basis.cols(); ++j) {
-      Eigen::Index i;
-      solve_basis_->basis.col(j).cwiseAbs().maxCoeff(&i);
-      ++solve_piece_modes_[components_[i]];
-    }
-  }
+  for (const int c :
+       solve_basis_ == basis_ ? piece_of_mode_ : piece_of_columns(solve_basis_->basis, components_))
+    ++solve_piece_modes_[c];
   if (options_.energy == DeformEnergy::Arap) {
     arap_ = std::make_unique<ArapSolver>(mesh_, base_, spectral ? solve_basis_ : nullptr,
                                          options_.arap, moving);
