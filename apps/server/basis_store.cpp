@@ -20,11 +20,8 @@ PreparedBasis prepare_basis(const TriangleMesh& mesh, int modes, EigenSolver sol
   o.progress = progress;
   const bool cache = std::filesystem::is_directory(cache_dir);
   // A basis in the cache (this one, or the exact one for a multilevel request) is loaded.
-  ManifoldHarmonicsOptions exact = o;
-  exact.solver = EigenSolver::BlockKrylov;
-  const std::filesystem::path file = cache ? cache_dir / basis_file_name(mesh, o) : "";
-  const bool cached = cache && (std::filesystem::exists(file) ||
-                                std::filesystem::exists(cache_dir / basis_file_name(mesh, exact)));
+  const std::filesystem::path file = cache ? cached_basis_file(mesh, o, cache_dir) : "";
+  const bool cached = cache && std::filesystem::exists(file);
   ObtainedBasis basis = obtain_basis(mesh, o, cached ? cache_dir : "");
   const bool save = cache && !basis.loaded && basis.warning.empty();  // a converged basis
   return {std::move(basis.harmonics), basis.seconds, basis.loaded ? "cache" : "computed",

@@ -156,12 +156,9 @@ struct EditorSession::State {
   std::vector<Entry> history;
   size_t at = 0;
   uint32_t seq = 0;
-  Vertices result;            // the last detailed result (the rest shape before any frame)
-  bool result_stale = false;  // previews were solved since
-  std::optional<PreviewMesh> preview;
-  // The deformer of previews: the same without details (DetailMethod::None), so that a preview
-  // frame skips the detail reconstruction; the preview adds them back as displacements.
-  std::optional<SpectralDeformer> sketch;
+  Vertices result;                     // the last detailed result (the rest shape before any frame)
+  bool result_stale = false;           // previews were solved since
+  std::optional<PreviewMesh> preview;  // drawn during drags (SpectralDeformer::preview)
   double selection_seconds = 0.0, pin_error = 0.0;
   double influence = 0.0;  // the region of influence, of the diagonal (0: none)
   // The last full frame sent added displacements while the transfer's factorisation ran.
@@ -331,7 +328,6 @@ void EditorSession::text_message(std::string_view message) {
     const int64_t k = j["vertices"].get<int64_t>();
     s.preview = make_preview(s.rest_mesh(s.pose),
                              static_cast<int>(std::clamp<int64_t>(k, 0, s.rest().rows())));
-    sync_sketch();
     return send_(true, encode_preview(*s.preview));
   }
   if (type == "export_mesh") {
@@ -446,10 +442,8 @@ void EditorSession::change_settings(std::string_view message) {
     s.options = o;
     config_.modes = modes;  // meshes opened later start with these settings too
     config_.options = o;
-    sync_sketch();
   } else if (new_influence && s.has_handles) {
     s.deformer->set_selection(s.solved(s.edit.selection));
-    sync_sketch();
   }
   s.base_view = base_view;
   solve_and_send();
@@ -482,7 +476,6 @@ void EditorSession::set_edit(GroupSelection edit, bool record, bool echo) {
       if (s.has_handles) s.deformer->set_selection(s.solved(s.edit.selection));
       throw;
     }
-    if (s.sketch) s.sketch->set_selection(s.solved(edit.selection));
   }
   s.selection_seconds = seconds_since(start);
   s.pin_error = pin_error;
@@ -529,7 +522,6 @@ void EditorSession::restore(size_t entry) {
     s.has_handles = false;
     s.result = s.rest();
     s.result_stale = false;
-    sync_sketch();
     send_mesh();
     send_ready();
   }
@@ -580,7 +572,6 @@ void EditorSession::apply_pose() {
   s.has_handles = false;
   s.result = s.rest();
   s.result_stale = false;
-  sync_sketch();
   send_mesh();
   send_ready();
   set_edit(std::move(edit), true, true);
@@ -813,16 +804,6 @@ void EditorSession::detail_ready() {
   send_state();
 }
 
-void EditorSession::sync_sketch() {
-  State& s = *state_;
-  s.sketch.reset();
-  if (!s.preview) return;
-  DeformOptions o = s.options;
-  o.detail = DetailMethod::None;
-  s.sketch.emplace(s.rest_mesh(s.pose), s.basis().harmonics, o);
-  if (s.has_handles) s.sketch->set_selection(s.solved(s.edit.selection));
-}
-
 const Vertices& EditorSession::result(bool final) {
   State& s = *state_;
   if (final && s.has_handles) {  // with the transfer's details, not the displacements meanwhile
@@ -839,14 +820,23 @@ void EditorSession::solve_and_send(bool preview) {
   const FrameView view{s.base_view, preview && s.preview.has_value()};
   const PreviewMesh* coarse = s.preview ? &*s.preview : nullptr;
   if (!s.has_handles) {
-    return send_(true, encode_frame_result(s.seq, view, {}, s.rest(), s.rest(), coarse));
+    const Vertices& rest = s.rest();
+    return send_(true, encode_frame_result(
+                           s.seq, view, {},
+                           view.preview ? Vertices(rest(s.preview->vertices, Eigen::all)) : rest,
+                           rest, coarse));
   }
-  SpectralDeformer& deformer = view.preview ? *s.sketch : *s.deformer;
-  Vertices shown = deformer.solve(s.edit.transforms);
+  SpectralDeformer& deformer = *s.deformer;
+  Vertices shown;
   if (view.preview) {
-    if (!s.base_view) shown += s.rest() - deformer.base();  // the details as displacements
+    shown = deformer.preview(s.edit.transforms, s.preview->vertices);
+    if (s.base_view) {  // the smooth base: the details taken off again
+      const std::vector<int>& at = s.preview->vertices;
+      shown -= s.rest()(at, Eigen::all) - deformer.base()(at, Eigen::all);
+    }
     s.result_stale = true;
   } else {
+    shown = deformer.solve(s.edit.transforms);
     s.result = std::move(shown);
     s.result_stale = false;
     s.shown_displacements = deformer.applied_detail() != s.options.detail;

@@ -148,7 +148,6 @@ class EditorSession {
   void open_scene(const NamedFile& file);
   // `preview`: solved without details and sent at the preview's vertices only.
   void solve_and_send(bool preview = false);
-  void sync_sketch();  // the previews' deformer after the deformer changed
   // The detailed result of the current transforms, as shown; `final`: with the transfer's
   // details (waits for its background factorisation; exports and poses).
   const Vertices& result(bool final = false);

@@ -271,13 +271,16 @@ std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& 
                                 const PreviewMesh* preview) {
   const bool subset = view.preview && preview != nullptr;
   const size_t n = subset ? preview->vertices.size() : static_cast<size_t>(positions.rows());
+  if (static_cast<size_t>(positions.rows()) != n) {
+    throw InputError("frame result: " + std::to_string(positions.rows()) + " positions for " +
+                     std::to_string(n) + " vertices");
+  }
   const auto vertex = [&](size_t i) {
     return subset ? preview->vertices[i] : static_cast<Eigen::Index>(i);
   };
   double largest = 0.0;
   for (size_t i = 0; i < n; ++i) {
-    largest =
-        std::max(largest, (positions.row(vertex(i)) - rest.row(vertex(i))).cwiseAbs().maxCoeff());
+    largest = std::max(largest, (positions.row(i) - rest.row(vertex(i))).cwiseAbs().maxCoeff());
   }
   const float scale = largest > 0.0 ? static_cast<float>(largest / 32767.0) : 1.0f;
   Writer w;
@@ -297,7 +300,7 @@ std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& 
   w.put(scale);
   for (size_t i = 0; i < n; ++i) {
     for (int k = 0; k < 3; ++k) {
-      const double d = (positions(vertex(i), k) - rest(vertex(i), k)) / scale;
+      const double d = (positions(i, k) - rest(vertex(i), k)) / scale;
       w.put(static_cast<int16_t>(std::clamp(std::lround(d), -32767L, 32767L)));
     }
   }

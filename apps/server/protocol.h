@@ -146,7 +146,8 @@ std::string encode_mesh_message(const TriangleMesh& mesh);
 std::string encode_preview(const PreviewMesh& preview);
 std::string encode_appearance(const Appearance& appearance);
 std::string encode_texture(uint32_t material, std::string_view mime, std::string_view image);
-// `positions` and `rest`: the whole mesh's; a preview view sends `preview`'s vertices.
+// `rest`: the whole mesh's; `positions`: the whole mesh's, or in a preview view those of
+// `preview`'s vertices, in its order (InputError for another count).
 std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& stats,
                                 const Vertices& positions, const Vertices& rest,
                                 const PreviewMesh* preview = nullptr);

@@ -33,6 +33,8 @@ def _status(layout, obj, s):
     if "solve_ms" in st:
         layout.label(text=f"Solve {st['solve_ms']:.1f} ms, {st['iterations']} iterations")
         layout.label(text=f"Write {st['write_ms']:.1f} ms")
+    if "detail" in st:
+        layout.label(text=st["detail"], icon="TIME")
     if "note" in st:
         layout.label(text=st["note"], icon="INFO")
     if "error" in st:

@@ -2,6 +2,7 @@
 # (n, 3), F and index arrays integer (never float). Arrays out: float64 V and int32 F in Fortran
 # order, moved out of the library without a copy; views of a basis are read-only.
 import os
+import pathlib
 from collections.abc import Callable, Sequence
 from typing import Any, Literal, overload
 
@@ -151,6 +152,15 @@ def manifold_harmonics(
     progress: _Progress | None = None,
     seed: int = 1,
 ) -> tuple[_Float, _Float]: ...
+def basis_cache_file(
+    V: npt.ArrayLike,
+    F: npt.ArrayLike,
+    k: int,
+    *,
+    cache: _Path,
+    mass: _Mass = "lumped",
+    eigensolver: Literal["krylov", "lanczos", "multilevel", "auto"] = "krylov",
+) -> pathlib.Path: ...
 def load_basis(path: _Path, V: npt.ArrayLike, F: npt.ArrayLike) -> tuple[_Float, _Float]: ...
 def save_basis(
     path: _Path,
@@ -211,6 +221,7 @@ class SpectralDeformer:
         constraints: Literal["soft", "hard"] = ...,
         unconstrained: Literal["follow", "keep", "error"] = ...,
         float32_basis: bool = ...,
+        background_transfer: bool = ...,
         iterations: int = ...,
         clusters: int = ...,
         arap_tolerance: float = ...,
@@ -224,6 +235,9 @@ class SpectralDeformer:
     def solve(self, transforms: npt.ArrayLike | Sequence[npt.ArrayLike]) -> _Float: ...
     def base_miss(self) -> dict[str, float]: ...
     def constraint_error(self, X: npt.ArrayLike) -> dict[str, float]: ...
+    @property
+    def detail_pending(self) -> bool: ...
+    def wait_for_detail(self) -> None: ...
     @property
     def base(self) -> _Float: ...
     @property

@@ -138,8 +138,11 @@ eigenpairs (copied); mass, cache, progress, tolerance: as manifold_harmonics tak
 the basis is computed here. With solver="spatial" and no basis, the base is the mesh itself.
 Keywords: the deformation options (energy="linear"|"arap", ks, kb, constraint_weight,
 detail="none"|"displacement"|"frames"|"transfer", solver="spectral"|"spatial",
-constraints="soft"|"hard", unconstrained="follow"|"keep"|"error", float32_basis, and for ARAP
-iterations, clusters, arap_tolerance, arap_bending, history, warm_start).)")
+constraints="soft"|"hard", unconstrained="follow"|"keep"|"error", float32_basis,
+background_transfer (the transfer's Poisson system built and factored on a thread of its own:
+set_selection returns at once and solve() adds the details as displacements until it is ready,
+see detail_pending), and for ARAP iterations, clusters, arap_tolerance, arap_bending, history,
+warm_start).)")
       .def(
           "set_selection",
           [](Deformer& d, py::handle handles, py::handle fixed) {
@@ -188,6 +191,23 @@ put on their targets (constraint_error).)")
           py::arg("X"),
           "Distances of a solve() result's constrained vertices to their targets, over the "
           "bounding-box diagonal: {'max', 'rms'}.")
+      .def_property_readonly(
+          "detail_pending",
+          [](Deformer& d) {
+            const std::lock_guard lock(d.mutex);
+            return d.deformer->detail_pending();
+          },
+          "background_transfer: whether the transfer's factorisation for the last selection "
+          "still runs (solve() adds the details as displacements meanwhile; False otherwise).")
+      .def(
+          "wait_for_detail",
+          [](Deformer& d) {
+            py::gil_scoped_release release;
+            const std::lock_guard lock(d.mutex);
+            d.deformer->wait_for_detail();
+          },
+          "background_transfer: waits until the transfer's factorisation for the last selection "
+          "is ready (at once otherwise). Raises SolverError where it failed.")
       .def_property_readonly(
           "base",
           [](py::object self) { return view(self.cast<Deformer&>().deformer->base(), self); },

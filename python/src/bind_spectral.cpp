@@ -11,6 +11,7 @@
 #include "specdeform/operators/cotan_laplacian.h"
 #include "specdeform/operators/mass_matrix.h"
 #include "specdeform/spectral/basis_cache.h"
+#include "specdeform/spectral/basis_store.h"
 #include "specdeform/spectral/spectral_transform.h"
 
 namespace specdeform::python {
@@ -160,6 +161,23 @@ and .residuals say so; its cache file is kept apart from the exact one's) or "au
 line's and the editor's choice: multilevel from 200,000 vertices, krylov below).
 Raises SolverError if the eigensolver does not converge.)");
 
+  m.def(
+      "basis_cache_file",
+      [](py::handle V, py::handle F, int k, const std::filesystem::path& cache,
+         const std::string& mass, const std::string& eigensolver) {
+        ManifoldHarmonicsOptions o;
+        o.num_modes = k;
+        o.mass = mass_from_name(mass);
+        const TriangleMesh mesh = to_mesh(V, F);
+        o.solver = eigensolver == "auto" ? default_eigensolver(mesh.num_vertices(), o.policy)
+                                         : eigen_solver_from_name(eigensolver);
+        return cached_basis_file(mesh, o, cache);
+      },
+      py::arg("V"), py::arg("F"), py::arg("k"), py::kw_only(), py::arg("cache"),
+      py::arg("mass") = "lumped", py::arg("eigensolver") = "krylov",
+      R"(The file of the cache folder `cache` that manifold_harmonics(V, F, k, cache=cache, ...)
+reads, or writes when it does not exist: to compute a basis without a cache and save it later
+(save_basis), off the path of the work that waits for it.)");
   m.def(
       "load_basis",
       [](const std::filesystem::path& path, py::handle V, py::handle F) {

@@ -49,6 +49,8 @@ const std::map<std::string, Setter>& setters() {
          o.unconstrained = unconstrained_pieces_from_name(text(v, k));
        }},
       {"float32_basis", [](auto& o, auto v, auto& k) { o.float32_basis = boolean(v, k); }},
+      {"background_transfer",
+       [](auto& o, auto v, auto& k) { o.background_transfer = boolean(v, k); }},
       {"iterations", [](auto& o, auto v, auto& k) { o.arap.max_iterations = integer(v, k); }},
       {"clusters", [](auto& o, auto v, auto& k) { o.arap.clusters = integer(v, k); }},
       {"arap_tolerance", [](auto& o, auto v, auto& k) { o.arap.tolerance = number(v, k); }},
@@ -87,6 +89,7 @@ py::dict to_dict(const DeformOptions& o) {
   d["constraints"] = std::string(name(o.constraints));
   d["unconstrained"] = std::string(name(o.unconstrained));
   d["float32_basis"] = o.float32_basis;
+  d["background_transfer"] = o.background_transfer;
   d["iterations"] = o.arap.max_iterations;
   d["clusters"] = o.arap.clusters;
   d["arap_tolerance"] = o.arap.tolerance;

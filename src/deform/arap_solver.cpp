@@ -12,6 +12,7 @@
 #include "linalg/basis_product.h"
 #include "linalg/nearest_rotation.h"
 #include "linalg/parallel.h"
+#include "linalg/sparse_basis_product.h"
 #include "membrane_stiffness.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/vertex_clusters.h"
@@ -258,9 +259,16 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
         }
       }
     }
+    // Column by column (contiguous writes, reads within one column of H), on two threads.
     Eigen::MatrixXd differences(dropped.size(), H.cols());
-    for (size_t e = 0; e < dropped.size(); ++e)
-      differences.row(e) = weight[e] * (H.row(dropped[e].first) - H.row(dropped[e].second));
+    detail::split_in_two(H.cols(), [&](Eigen::Index begin, Eigen::Index end) {
+      for (Eigen::Index c = begin; c < end; ++c) {
+        const double* h = H.col(c).data();
+        double* out = differences.col(c).data();
+        for (size_t e = 0; e < dropped.size(); ++e)
+          out[e] = weight[e] * (h[dropped[e].first] - h[dropped[e].second]);
+      }
+    });
     membrane_correction_ = differences.transpose() * differences;
     // Bending in the mixed form (deform/reduced_forms.h): a curvature M^-1 K s' taken as its
     // projection H S c' onto the span, s' = H c', S = H^T K H; the base's coefficients a from
@@ -271,12 +279,14 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
         lumped ? Sparse(mass.asDiagonal()) : mass_matrix(mesh, basis->mass, basis->laplacian);
     const Eigen::MatrixX3d curvature = H * (S * (H.transpose() * (own_mass * base)));
     const Sparse weights = curvature_weights(curvature, mass, label_, clusters.count);
-    reduced_ = stretch * H + bend * (Eigen::MatrixXd(weights * H) * S);  // no n x m temporary
+    const std::vector<Eigen::MatrixXd> reduced =
+        detail::sparse_basis_products({&stretch, &weights, &cluster_mean}, H);
+    reduced_ = reduced[0] + bend * (reduced[1] * S);
     rest_ = stretch * base + bend * (weights * curvature);
     reduced_hessian_ =
         S + 0.5 * bend * detail::reduced_bending(S, mass, H, lumped) + membrane_correction_;
     reduced_transposed_ = reduced_.transpose();
-    reduced_mean_ = cluster_mean * H;
+    reduced_mean_ = reduced[2];
   } else {
     operator_ = stretch + bend * bending_operator(K, mass, base, label_, clusters.count);
     rest_ = operator_ * base;

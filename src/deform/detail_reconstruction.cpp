@@ -8,6 +8,12 @@
 #include <optional>
 #include <thread>
 
+#if defined(__linux__)
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
+
 #include <Eigen/CholmodSupport>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -218,6 +224,9 @@ struct DetailReconstruction::Poisson {
 // newest is factored).
 struct DetailReconstruction::Background {
   void run(Poisson& poisson, TriangleMesh mesh, Vertices base) {
+#if defined(__linux__)
+    setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 19);  // this thread's
+#endif
     bool built = true;  // else `error` says why, for good
     try {
       poisson.build(mesh, base, detail::AnchoredPoisson::Solves::Many);

@@ -185,13 +185,14 @@ void SpectralDeformer::set_selection(const Selection& selection) {
   state_ = ArapState{};  // warm starts continue a drag, not across selections
 }
 
-Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms) {
+Eigen::MatrixX3d SpectralDeformer::solve_coefficients(
+    const std::vector<Eigen::Affine3d>& transforms) {
   if (constrained_.vertices.empty()) throw InputError("deformation: no selection set");
   if (options_.single_solve && !reduced_ && !spatial_) {
     throw InputError("deformation: a single-solve deformer solves once");
   }
-  Clock clock, total;
-  const Eigen::MatrixX3d base_targets = constraint_targets(constrained_, base_, transforms);
+  Clock clock;
+  Eigen::MatrixX3d base_targets = constraint_targets(constrained_, base_, transforms);
   Eigen::MatrixX3d displacement_targets = base_targets;
   for (size_t i = 0; i < constrained_.vertices.size(); ++i)
     displacement_targets.row(i) -= base_.row(constrained_.vertices[i]);
@@ -211,13 +212,6 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
     } else {
       state_.x = reduced_->solve(targets, Eigen::MatrixX3d());
     }
-    frame_.reduced_solve = clock.lap();
-    if (options_.float32_basis) {
-      detail::add_basis_product(base_, basis32_, state_.x, deformed_base_);
-    } else {
-      detail::add_basis_product(base_, solve_basis_->basis, state_.x, deformed_base_);
-    }
-    frame_.inverse_transform = clock.lap();
   } else {
     const SpatialSolver::Targets targets = spatial_->prepare(displacement_targets);
     if (arap_) {
@@ -228,10 +222,64 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
     } else {
       state_.x = spatial_->solve(targets, Eigen::MatrixX3d());
     }
-    frame_.reduced_solve = clock.lap();
-    deformed_base_ = base_ + state_.x;
-    frame_.inverse_transform = clock.lap();
   }
+  frame_.reduced_solve = clock.lap();
+  return base_targets;
+}
+
+void SpectralDeformer::inverse_transform(Vertices& deformed) const {
+  if (!reduced_) {
+    deformed = base_ + state_.x;
+  } else if (options_.float32_basis) {
+    detail::add_basis_product(base_, basis32_, state_.x, deformed);
+  } else {
+    detail::add_basis_product(base_, solve_basis_->basis, state_.x, deformed);
+  }
+  // Free pieces stay exactly where they are (the solvers hold them only as well as soft
+  // constraints do), then follow the deformed surface around them.
+  const std::vector<int>& constrained = constrained_.vertices;
+  for (size_t i = constrained_.first_free; i < constrained.size(); ++i)
+    deformed.row(constrained[i]) = base_.row(constrained[i]);
+}
+
+Vertices SpectralDeformer::preview(const std::vector<Eigen::Affine3d>& transforms,
+                                   const std::vector<int>& vertices) {
+  for (const int v : vertices) {
+    if (v < 0 || v >= mesh_.num_vertices()) {
+      throw InputError("preview: vertex " + std::to_string(v) + " out of range");
+    }
+  }
+  Clock clock, total;
+  solve_coefficients(transforms);
+  clock.lap();
+  Vertices out(vertices.size(), 3);
+  if (follow_) {
+    Vertices deformed;
+    inverse_transform(deformed);
+    follow_->apply(follow_->motions(base_, deformed), base_, deformed);
+    for (size_t k = 0; k < vertices.size(); ++k)
+      out.row(k) = mesh_.V.row(vertices[k]) + deformed.row(vertices[k]) - base_.row(vertices[k]);
+  } else {
+    for (size_t k = 0; k < vertices.size(); ++k) {
+      const int v = vertices[k];
+      if (reduced_) {
+        out.row(k) = mesh_.V.row(v) + solve_basis_->basis.row(v) * state_.x;
+      } else {
+        out.row(k) = mesh_.V.row(v) + state_.x.row(v);
+      }
+    }
+  }
+  frame_.inverse_transform = clock.lap();
+  frame_.total = total.lap();
+  return out;
+}
+
+Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms) {
+  Clock total;
+  const Eigen::MatrixX3d base_targets = solve_coefficients(transforms);
+  Clock clock;
+  inverse_transform(deformed_base_);
+  frame_.inverse_transform = clock.lap();
   const std::vector<int>& constrained = constrained_.vertices;
   base_miss_ = ConstraintError{};
   for (size_t i = 0; i < constrained_.first_free; ++i) {
@@ -243,10 +291,6 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
   base_miss_.max /= diagonal;
   base_miss_.rms =
       std::sqrt(base_miss_.rms / std::max<size_t>(constrained_.first_free, 1)) / diagonal;
-  // Free pieces stay exactly where they are (the solvers hold them only as well as soft
-  // constraints do), then follow the deformed surface around them.
-  for (size_t i = constrained_.first_free; i < constrained.size(); ++i)
-    deformed_base_.row(constrained[i]) = base_.row(constrained[i]);
   double deferred = 0.0;
   if (options_.single_solve) {  // the solvers' memory back before the details take theirs
     clock.lap();

@@ -62,17 +62,22 @@ std::string basis_file_name(const TriangleMesh& mesh, const ManifoldHarmonicsOpt
   return name + ".sdbasis";
 }
 
+std::filesystem::path cached_basis_file(const TriangleMesh& mesh, const ManifoldHarmonicsOptions& o,
+                                        const std::filesystem::path& folder) {
+  ManifoldHarmonicsOptions exact = o;
+  exact.solver = EigenSolver::BlockKrylov;
+  const std::filesystem::path better = folder / basis_file_name(mesh, exact);
+  if (o.solver == EigenSolver::Multilevel && std::filesystem::exists(better)) return better;
+  return folder / basis_file_name(mesh, o);
+}
+
 ObtainedBasis obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonicsOptions& o,
                            const std::filesystem::path& cache) {
   const auto start = std::chrono::steady_clock::now();
   ObtainedBasis out;
   out.file = cache;
   if (!cache.empty() && std::filesystem::is_directory(cache)) {
-    out.file = cache / basis_file_name(mesh, o);
-    ManifoldHarmonicsOptions exact = o;
-    exact.solver = EigenSolver::BlockKrylov;
-    const std::filesystem::path better = cache / basis_file_name(mesh, exact);
-    if (o.solver == EigenSolver::Multilevel && std::filesystem::exists(better)) out.file = better;
+    out.file = cached_basis_file(mesh, o, cache);
   }
   ManifoldHarmonics h;
   if (!out.file.empty() && std::filesystem::exists(out.file)) {

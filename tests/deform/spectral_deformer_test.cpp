@@ -72,6 +72,49 @@ TEST(SpectralDeformer, IdentityReproducesTheInput) {
   }
 }
 
+// A preview is solve()'s frame with the details as displacements, at the vertices asked for,
+// in their order: equal to a Displacement deformer's solve() there, for each energy and solver;
+// and where free pieces follow, their vertices move as solve() moves the pieces' bases.
+TEST(SpectralDeformer, APreviewIsTheFrameWithDisplacements) {
+  const BarScene s = bar_scene(6);
+  const double diagonal = bounding_box_diagonal(s.mesh.V);
+  const ManifoldHarmonics h = harmonics(s.mesh, 40);
+  const std::vector<int> at = {s.mesh.num_vertices() - 1, 0, 17, s.selection.handles[0][0]};
+  const Eigen::Affine3d turn = rotation_about({3.9, 0.0, 0.0}, 30.0);
+  for (const DeformSolver solver : {DeformSolver::Spectral, DeformSolver::Spatial}) {
+    for (const DeformEnergy energy : {DeformEnergy::Linear, DeformEnergy::Arap}) {
+      DeformOptions o;
+      o.solver = solver;
+      o.energy = energy;
+      o.detail = DetailMethod::Displacement;
+      SpectralDeformer deformer(s.mesh, solver == DeformSolver::Spectral ? h : ManifoldHarmonics{},
+                                o);
+      deformer.set_selection(s.selection);
+      const Vertices preview = deformer.preview({turn}, at);
+      const Vertices full = deformer.solve({turn});
+      ASSERT_EQ(preview.rows(), static_cast<Eigen::Index>(at.size()));
+      EXPECT_LT((preview - full(at, Eigen::all)).cwiseAbs().maxCoeff(), 1e-9 * diagonal)
+          << static_cast<int>(solver) << " " << static_cast<int>(energy);
+    }
+  }
+  // A sphere beside the bar, with no handle or fixed vertex: it follows the bar's base.
+  TriangleMesh two = test::concatenate(s.mesh, make_icosphere(1));
+  const int sphere = s.mesh.num_vertices();
+  two.V.bottomRows(42).rowwise() += Eigen::RowVector3d(4.3, 0.0, 0.0);
+  DeformOptions o;
+  o.detail = DetailMethod::None;
+  SpectralDeformer deformer(two, harmonics(two, 40), o);
+  deformer.set_selection(s.selection);
+  const std::vector<int> on_sphere = {sphere, sphere + 41};
+  const Vertices preview = deformer.preview({turn}, on_sphere);
+  const Vertices full = deformer.solve({turn});  // the base only (DetailMethod::None)
+  const Vertices expected = full(on_sphere, Eigen::all) + two.V(on_sphere, Eigen::all) -
+                            deformer.base()(on_sphere, Eigen::all);
+  EXPECT_LT((preview - expected).cwiseAbs().maxCoeff(), 1e-9 * diagonal);
+  EXPECT_GT((preview - two.V(on_sphere, Eigen::all)).norm(), 0.05);
+  EXPECT_THROW(deformer.preview({turn}, {two.num_vertices()}), InputError);
+}
+
 // With every eigenvector (m = n) the spectral space is the whole space: the spectral and the
 // spatial minimisers of the same energy under the same constraints coincide.
 TEST(SpectralDeformer, FullBasisEqualsSpatial) {

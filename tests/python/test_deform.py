@@ -374,3 +374,38 @@ def test_scene_vertices_the_reader_dropped(tmp_path):
     assert [list(h) for h in s.handles] == [[0]] and list(s.fixed) == [1]
     assert s.options["unconstrained"] == "error" and s.options["iterations"] == 9
     assert s.options["arap_bending"] == 0.5
+
+
+def test_background_transfer_adds_displacements_until_it_is_ready(bar):
+    """background_transfer: set_selection returns before the transfer is factored; once it is
+    (wait_for_detail), the frame is the one a deformer without it solves."""
+    V, F = bar
+    evals, evecs = specdeform.manifold_harmonics(V, F, 20)
+    handle, fixed = V[:, 0] > 3.5, V[:, 0] < 0.5
+    T = turn(50, V[handle].mean(axis=0))
+    background = specdeform.SpectralDeformer(V, F, basis=(evals, evecs), background_transfer=True)
+    plain = specdeform.SpectralDeformer(V, F, basis=(evals, evecs))
+    assert background.options["background_transfer"] and not plain.options["background_transfer"]
+    for d in (background, plain):
+        d.set_selection([handle], fixed)
+    early = background.solve(T)
+    background.wait_for_detail()
+    assert not background.detail_pending and not plain.detail_pending
+    expected = plain.solve(T)
+    np.testing.assert_allclose(background.solve(T), expected, atol=1e-9)
+    # Before it was ready (unless a fast machine was ready already) the details were added as
+    # displacements: the same base, the details not turned with it.
+    assert relative_difference(early, expected, V) < 0.05
+    plain.wait_for_detail()  # at once
+
+
+def test_basis_cache_file_is_the_file_manifold_harmonics_writes(tmp_path, bar):
+    V, F = bar
+    path = specdeform.basis_cache_file(V, F, 8, cache=tmp_path)
+    assert not path.exists() and path.parent == tmp_path
+    specdeform.manifold_harmonics(V, F, 8, cache=tmp_path)
+    assert path.exists()
+    # A multilevel request is served by the exact basis when the folder has it.
+    assert specdeform.basis_cache_file(V, F, 8, cache=tmp_path, eigensolver="multilevel") == path
+    other = specdeform.basis_cache_file(V, F, 9, cache=tmp_path, eigensolver="multilevel")
+    assert other.name.endswith("-m9-lumped-multilevel.sdbasis")

@@ -121,8 +121,12 @@ TEST(Protocol, MeshAndFrameResultLayouts) {
   EXPECT_THROW(decode_frame_positions(frame.substr(0, 60), m.V), InputError);
   // A preview frame carries the preview's vertices only, in its order.
   const PreviewMesh preview{{2, 1}, Faces(0, 3)};
-  const std::string coarse = encode_frame_result(3, {false, true}, {}, moved, m.V, &preview);
+  const Vertices at_preview = moved(std::vector<int>{2, 1}, Eigen::all);
+  const std::string coarse = encode_frame_result(3, {false, true}, {}, at_preview, m.V, &preview);
   EXPECT_EQ(coarse.size(), 52u + 12u);
+  EXPECT_LT((decode_frame_positions(coarse, m.V, &preview) - at_preview).cwiseAbs().maxCoeff(),
+            1e-4);
+  EXPECT_THROW(encode_frame_result(3, {false, true}, {}, moved, m.V, &preview), InputError);
   uint32_t view = 0;
   std::memcpy(&view, coarse.data() + 12, 4);
   EXPECT_EQ(view, 2u);

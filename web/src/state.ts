@@ -38,6 +38,7 @@ export const stats = {
   receiveLatencies: [] as number[], // to its result received
   drawTimes: [] as number[],
   meshDrawn: null as number | null, // performance.now() when the last new mesh was first drawn
+  detailedDrawn: null as number | null, // and when the last frame of the whole mesh was drawn
   pointerMoves: 0, // pointer moves over the view, and how many of them were acted on (coalesced)
   pointerActed: 0,
 };
@@ -413,6 +414,7 @@ export class EditorState {
     for (const s of this.sentAt.keys()) if (s <= this.pendingDraw) this.sentAt.delete(s);
     stats.framesDrawn++;
     if (this.viewer.showingPreview) stats.previewsDrawn++;
+    else stats.detailedDrawn = now;
     stats.drawTimes.push(now);
     if (stats.drawTimes.length > 2000) stats.drawTimes.splice(0, 1000);
     this.lastDrawn = this.pendingDraw;

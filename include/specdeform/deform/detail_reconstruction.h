@@ -18,9 +18,11 @@
 //                  anchor set and then updated by the anchors that change (row additions and
 //                  deletions); a frame is O(f) plus one back-substitution with 3 columns, both
 //                  on two threads. In the background (for interactive front ends), a thread
-//                  of its own builds the system and factors each new anchor set while
+//                  of its own, at the lowest CPU priority (Linux: frames and the page keep
+//                  the cores), builds the system and factors each new anchor set while
 //                  apply() adds the details as displacements; apply() switches to the
-//                  transfer once the newest anchors are factored (a million vertices: 2-3 s).
+//                  transfer once the newest anchors are factored (692k vertices on two idle
+//                  cores: 6-9 s for the first, most of it METIS's ordering; then 1-3 s).
 // Where the low-pass collapsed the base (a small piece keeps only its constant mode among the
 // first m and its base is a point; thin tips and slivers nearly so), a base triangle's or
 // one-ring's frame is rounding noise. Such a triangle (its base edges below 1e-3 of the detailed

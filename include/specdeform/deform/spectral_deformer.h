@@ -89,6 +89,15 @@ class SpectralDeformer {
   // The deformed detailed mesh (n x 3) for one transform per handle group.
   Vertices solve(const std::vector<Eigen::Affine3d>& transforms);
 
+  // A quick look at a frame for drags (the editor's coarse preview): the detailed mesh at
+  // `vertices` only (k x 3, in their order), the smooth base solved as solve() solves it (warm
+  // starts continue from it) and the details added as displacements (x - s). Costs the reduced
+  // solve and k rows of the inverse transform (all n rows where free pieces follow the surface,
+  // which their motions need). deformed_base(), base_miss() and frame_timings().detail stay
+  // those of the last solve(); InputError for a vertex out of range.
+  Vertices preview(const std::vector<Eigen::Affine3d>& transforms,
+                   const std::vector<int>& vertices);
+
   // Error of `result` (a solve() output) against the targets of the last solve(): 0 where the
   // details meet them exactly (transfer, frames, displacement anchor the constrained vertices).
   ConstraintError constraint_error(const Vertices& result) const;
@@ -137,6 +146,11 @@ class SpectralDeformer {
 
  private:
   bool by_moving_pieces() const;
+  // The reduced (or spatial) solve of a frame: state_, arap_report_ and frame_.reduced_solve.
+  // Returns the smooth base's targets of the constrained vertices.
+  Eigen::MatrixX3d solve_coefficients(const std::vector<Eigen::Affine3d>& transforms);
+  // deformed = base_ + H c (or + d), free pieces put back where they were.
+  void inverse_transform(Vertices& deformed) const;
   // The solvers in `basis`; ARAP's clusters on the `moving` vertices (n flags; empty: all).
   void build_solvers(std::shared_ptr<const ManifoldHarmonics> basis,
                      const std::vector<char>& moving = {});

@@ -30,6 +30,12 @@ inline constexpr double kUsableResidual = 1e-6;
 // The file name of the basis for `mesh` and `options` in a cache folder.
 std::string basis_file_name(const TriangleMesh& mesh, const ManifoldHarmonicsOptions& options);
 
+// The file of the cache folder `folder` that serves the request: the exact basis's where it
+// exists and a multilevel one is asked for, else basis_file_name()'s (which may not exist yet).
+std::filesystem::path cached_basis_file(const TriangleMesh& mesh,
+                                        const ManifoldHarmonicsOptions& options,
+                                        const std::filesystem::path& folder);
+
 struct ObtainedBasis {
   std::shared_ptr<const ManifoldHarmonics> harmonics;  // options.num_modes pairs (more on
                                                        // several pieces)
