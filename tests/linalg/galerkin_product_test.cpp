@@ -3,34 +3,23 @@
 #include <gtest/gtest.h>
 
 #include <random>
-#include <vector>
+
+#include "support/random_sparse.h"
 
 namespace specdeform {
 namespace {
 
 using Sparse = Eigen::SparseMatrix<double>;
 
-// A random sparse matrix with about `per_column` entries per column.
-Sparse random_sparse(int rows, int cols, int per_column, std::mt19937_64& rng) {
-  std::uniform_int_distribution<int> row(0, rows - 1);
-  std::normal_distribution<double> value;
-  std::vector<Eigen::Triplet<double>> t;
-  for (int j = 0; j < cols; ++j)
-    for (int k = 0; k < per_column; ++k) t.emplace_back(row(rng), j, value(rng));
-  Sparse A(rows, cols);
-  A.setFromTriplets(t.begin(), t.end());
-  return A;
-}
-
 // Against the plain sparse product, for a symmetric A with and without off-diagonal entries,
 // with columns of P that share rows and an empty column.
 TEST(GalerkinProducts, MatchTheSparseProducts) {
   std::mt19937_64 rng(7);
-  const Sparse B = random_sparse(400, 400, 5, rng);
+  const Sparse B = test::random_sparse(400, 400, 5, rng);
   const Sparse symmetric = Sparse(B + Sparse(B.transpose()));
   Sparse diagonal(400, 400);
   for (int i = 0; i < 400; ++i) diagonal.insert(i, i) = 1.0 + i;
-  Sparse P = random_sparse(400, 41, 12, rng);
+  Sparse P = test::random_sparse(400, 41, 12, rng);
   P.col(40) *= 0.0;
   P.prune(0.0);
   const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = P;

@@ -6,22 +6,12 @@
 #include <vector>
 
 #include "specdeform/exceptions.h"
+#include "support/random_sparse.h"
 
 namespace specdeform {
 namespace {
 
 using Sparse = Eigen::SparseMatrix<double>;
-
-Sparse random_wide(int rows, int cols, int per_column, std::mt19937_64& rng) {
-  std::uniform_int_distribution<int> row(0, rows - 1);
-  std::normal_distribution<double> value;
-  std::vector<Eigen::Triplet<double>> t;
-  for (int j = 0; j < cols; ++j)
-    for (int k = 0; k < per_column; ++k) t.emplace_back(row(rng), j, value(rng));
-  Sparse A(rows, cols);
-  A.setFromTriplets(t.begin(), t.end());
-  return A;
-}
 
 // Against Eigen's product: several matrices at once, row counts that are not a multiple of the
 // blocks (and one smaller than a block), empty columns, and an odd number of basis columns.
@@ -29,8 +19,8 @@ TEST(SparseBasisProducts, MatchEigensProduct) {
   std::mt19937_64 rng(3);
   for (const int n : {1, 37, 64, 1000, 4097}) {
     const Eigen::MatrixXd H = Eigen::MatrixXd::Random(n, 13);
-    const Sparse A = random_wide(30, n, 3, rng);
-    Sparse B = random_wide(7, n, 1, rng);
+    const Sparse A = test::random_sparse(30, n, 3, rng);
+    Sparse B = test::random_sparse(7, n, 1, rng);
     B.col(0) *= 0.0;
     B.prune(0.0);
     const std::vector<Eigen::MatrixXd> out = detail::sparse_basis_products({&A, &B}, H);
