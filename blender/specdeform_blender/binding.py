@@ -81,15 +81,18 @@ def _must_be_final():
 def _refresh_when_detailed(name):
     """A timer: once the transfer of `name`'s binding is factored, its pose is solved again with
     it (the frames meanwhile added the details as displacements)."""
-    obj = bpy.data.objects.get(name)
-    b = _bindings.get(name)
-    if obj is None or b is None or b.deformer is None:
+    obj, b = bpy.data.objects.get(name), _bindings.get(name)
+    if obj is None or b is None:
         return None
-    if b.deformer.detail_pending:
-        return 0.2
     b.status.pop("detail", None)
-    b.last = None
-    update(obj, b)
+    try:
+        if b.deformer.detail_pending:
+            b.status["detail"] = "details as displacements until the transfer is ready"
+            return 0.2
+        b.last = None
+        update(obj, b)
+    except library.specdeform.Error as e:  # a singular Poisson system, say
+        b.status["error"] = str(e)
     return None
 
 
@@ -104,7 +107,8 @@ def update(obj, b, depsgraph=None):
             b.deformer.wait_for_detail()
         elif "detail" not in b.status:
             b.status["detail"] = "details as displacements until the transfer is ready"
-            bpy.app.timers.register(functools.partial(_refresh_when_detailed, obj.name_full), first_interval=0.2)
+            refresh = functools.partial(_refresh_when_detailed, obj.name_full)
+            bpy.app.timers.register(refresh, first_interval=0.2)
     X = b.deformer.solve(blend(transforms, b.levels))
     solved = time.perf_counter()
     b.last = transforms  # before writing: the write triggers the depsgraph handler again
