@@ -66,6 +66,7 @@ GlbChunks split_glb(std::string_view data, const std::string& name) {
     }
     at += 8 + length;
   }
+  if (out.tail.empty()) out.tail = data.substr(std::min(at, data.size()));  // under a chunk header
   if (out.json.empty()) fail("no JSON chunk");
   return out;
 }
