@@ -54,6 +54,18 @@ py::array signal_array(Eigen::MatrixXd Y, bool vector) {
   return to_array(std::move(Y));
 }
 
+// The options of manifold_harmonics and basis_cache_file: k pairs, the mass by name, and the
+// eigensolver by name ("auto": the command line's choice for this mesh's size).
+ManifoldHarmonicsOptions harmonics_options(const TriangleMesh& mesh, int k, const std::string& mass,
+                                           const std::string& eigensolver) {
+  ManifoldHarmonicsOptions o;
+  o.num_modes = k;
+  o.mass = mass_from_name(mass);
+  o.solver = eigensolver == "auto" ? default_eigensolver(mesh.num_vertices(), o.policy)
+                                   : eigen_solver_from_name(eigensolver);
+  return o;
+}
+
 }  // namespace
 
 void bind_spectral(py::module_& m) {
@@ -130,13 +142,9 @@ returns (evecs.base). SpectralDeformer shares it without a copy.)")
       [](py::handle V, py::handle F, int k, const std::string& mass,
          std::optional<std::filesystem::path> cache, double tolerance,
          const std::string& eigensolver, py::object progress, uint64_t seed) {
-        ManifoldHarmonicsOptions o;
-        o.num_modes = k;
-        o.mass = mass_from_name(mass);
-        o.tolerance = tolerance;
         const TriangleMesh mesh = to_mesh(V, F);
-        o.solver = eigensolver == "auto" ? default_eigensolver(mesh.num_vertices(), o.policy)
-                                         : eigen_solver_from_name(eigensolver);
+        ManifoldHarmonicsOptions o = harmonics_options(mesh, k, mass, eigensolver);
+        o.tolerance = tolerance;
         o.seed = seed;
         return eigenpairs(obtain_basis(mesh, o, cache, progress));
       },
@@ -165,13 +173,8 @@ Raises SolverError if the eigensolver does not converge.)");
       "basis_cache_file",
       [](py::handle V, py::handle F, int k, const std::filesystem::path& cache,
          const std::string& mass, const std::string& eigensolver) {
-        ManifoldHarmonicsOptions o;
-        o.num_modes = k;
-        o.mass = mass_from_name(mass);
         const TriangleMesh mesh = to_mesh(V, F);
-        o.solver = eigensolver == "auto" ? default_eigensolver(mesh.num_vertices(), o.policy)
-                                         : eigen_solver_from_name(eigensolver);
-        return cached_basis_file(mesh, o, cache);
+        return cached_basis_file(mesh, harmonics_options(mesh, k, mass, eigensolver), cache);
       },
       py::arg("V"), py::arg("F"), py::arg("k"), py::kw_only(), py::arg("cache"),
       py::arg("mass") = "lumped", py::arg("eigensolver") = "krylov",
