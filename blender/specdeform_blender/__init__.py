@@ -17,6 +17,8 @@ bl_info = {
     "category": "Mesh",
 }
 
+import atexit
+
 import bpy
 
 from . import bake, binding, handlers, operators, properties, ui
@@ -42,6 +44,7 @@ _handlers = (
 
 
 def register():
+    atexit.register(binding.shutdown)
     for cls in classes:
         bpy.utils.register_class(cls)
     bpy.types.Object.specdeform = bpy.props.PointerProperty(type=properties.SpecdeformSettings)
@@ -50,6 +53,7 @@ def register():
 
 
 def unregister():
+    atexit.unregister(binding.shutdown)
     for handler_list, handler in _handlers:
         handler_list.remove(handler)
     binding.forget_all()

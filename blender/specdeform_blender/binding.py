@@ -33,6 +33,7 @@ class Binding:
 
 _bindings = {}  # Object.name_full -> Binding (a renamed object is bound again from the file)
 problems = {}  # Object.name_full -> why a bound object has no binding (one line)
+_jobs = set()  # BasisJobs whose thread still runs (computing, or saving the cache)
 
 
 def binding(obj):
@@ -43,6 +44,15 @@ def binding(obj):
 def forget_all():
     _bindings.clear()
     problems.clear()
+
+
+def shutdown():
+    """At exit (atexit): the cache files being saved written, and the deformers, with their
+    background threads, released while Python and the library are still whole."""
+    for job in list(_jobs):
+        job.cancel()
+        job._thread.join()
+    forget_all()
 
 
 def handles(obj):
@@ -220,6 +230,7 @@ class BasisJob:
         self.saving = False
         self._cancel, self._done = threading.Event(), threading.Event()
         self._thread = threading.Thread(target=self._run, args=(request,), daemon=True)
+        _jobs.add(self)
         self._thread.start()
 
     def _progress(self, fraction, stage):
@@ -255,6 +266,7 @@ class BasisJob:
             except (sd.Error, OSError) as e:
                 print(f"specdeform: warning: basis not cached: {e}")
             self.saving = False
+        _jobs.discard(self)
 
     def cancel(self):
         self._cancel.set()
