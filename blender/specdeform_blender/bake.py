@@ -12,12 +12,14 @@ CACHE_MODIFIER = "specdeform cache"
 
 
 def _poses(obj, scene, frames):
-    """The mesh's own coordinates at each frame (the handlers deform it), float32 (f, n, 3)."""
+    """The mesh's own coordinates at each frame (the handlers deform it, with the full details),
+    float32 (f, n, 3)."""
     current = scene.frame_current
     poses = []
-    for frame in frames:
-        scene.frame_set(frame)
-        poses.append(mesh_helpers.coordinates(obj.data))
+    with binding.final_frames():
+        for frame in frames:
+            scene.frame_set(frame)
+            poses.append(mesh_helpers.coordinates(obj.data))
     scene.frame_set(current)
     return np.array(poses)
 
@@ -136,6 +138,7 @@ class SPECDEFORM_OT_bake_pose(bpy.types.Operator):
 
     def execute(self, context):
         obj = context.object
+        binding.finish(obj)
         pose = mesh_helpers.coordinates(obj.data)
         _unbind(obj)
         _shape_key(obj, "specdeform pose", pose).value = 1.0

@@ -2,6 +2,7 @@
 worker thread (BasisJob), the deformer made from both (bind), and the mesh following its targets
 (update)."""
 
+import contextlib
 import functools
 import os
 import threading
@@ -15,6 +16,8 @@ from mathutils import Matrix
 from . import library, mesh_helpers
 
 WEIGHT_STEP = 0.01  # handle weights are rounded to this: each level is one group of the scene
+QUICK_ABOVE_MS = 50.0  # Quick drags: where a full update takes longer than this
+SETTLE_S = 0.25  # the full details once the targets rested this long
 
 
 @dataclass
@@ -28,6 +31,10 @@ class Binding:
     positions: np.ndarray = None  # float32 (n, 3): what is written into the mesh
     last: np.ndarray = None  # the transforms last solved for
     editing: bool = False  # in Edit Mode: the mesh shows its rest shape
+    exact: bool = True  # the mesh shows the full details (not displacements meanwhile)
+    full_ms: float = 0.0  # the last update with the full details took this long
+    moved: float = 0.0  # time of the last update shown with displacements
+    finishing: bool = False  # the timer that solves again with the full details is registered
     status: dict = field(default_factory=dict)
 
 
@@ -81,53 +88,103 @@ def blend(transforms, levels):
     return [(1 - w) * np.eye(4) + w * transforms[h] for h, w in levels]
 
 
+_final = 0  # inside final_frames()
+
+
+@contextlib.contextmanager
+def final_frames():
+    """Every frame solved inside carries the full details (Bake's frames)."""
+    global _final
+    _final += 1
+    try:
+        yield
+    finally:
+        _final -= 1
+
+
 def _must_be_final():
-    """Whether a frame must carry the transfer's details (a render, a background process) rather
-    than the displacements shown meanwhile in the window."""
+    """Whether a frame must carry the full details (a render, a background process, a bake)
+    rather than the displacements shown meanwhile in the window."""
     running = getattr(bpy.app, "is_job_running", lambda _: False)
-    return bpy.app.background or running("RENDER")
+    return _final > 0 or bpy.app.background or running("RENDER")
 
 
-def _refresh_when_detailed(name):
-    """A timer: once the transfer of `name`'s binding is factored, its pose is solved again with
-    it (the frames meanwhile added the details as displacements)."""
+def _finish_later(name):
+    """A timer: the pose of `name`'s binding, shown with its details as displacements (the
+    transfer was being factored, or a quick drag), solved again with the full details once the
+    transfer is ready and the targets rested for SETTLE_S."""
     obj, b = bpy.data.objects.get(name), _bindings.get(name)
     if obj is None or b is None:
         return None
-    b.status.pop("detail", None)
     try:
         if b.deformer.detail_pending:
-            b.status["detail"] = "details as displacements until the transfer is ready"
             return 0.2
-        b.last = None
-        update(obj, b)
+        wait = SETTLE_S - (time.perf_counter() - b.moved)
+        if wait > 0:
+            return wait
+        b.finishing = False
+        if not b.exact:
+            update(obj, b, full=True)
     except library.specdeform.Error as e:  # a singular Poisson system, say
+        b.finishing = False
         b.status["error"] = str(e)
     return None
 
 
-def update(obj, b, depsgraph=None):
-    """Solves for the targets' transforms and writes the positions, unless they did not move."""
+def finish(obj):
+    """The mesh with the full details of its pose (Apply, Bake Pose): waits for the transfer
+    where it is being factored and solves again where the mesh shows displacements."""
+    b = binding(obj)
+    if b is not None and not b.exact:
+        update(obj, b, full=True)
+
+
+def update(obj, b, depsgraph=None, full=False):
+    """Solves for the targets' transforms and writes the positions, unless they did not move.
+    In the window, where a full update is slow (over QUICK_ABOVE_MS) and Quick drags is on, a
+    moving target's pose is shown with its details as displacements (the library's preview: no
+    transfer) and solved in full once the targets rest; `full`, renders and bakes always solve
+    in full."""
     transforms = local_transforms(obj, depsgraph)
-    if b.last is not None and np.array_equal(transforms, b.last):
+    final = full or _must_be_final()
+    if b.last is not None and np.array_equal(transforms, b.last) and (b.exact or not final):
         return
     start = time.perf_counter()
-    if b.deformer.detail_pending:
-        if _must_be_final():
-            b.deformer.wait_for_detail()
-        elif "detail" not in b.status:
-            b.status["detail"] = "details as displacements until the transfer is ready"
-            refresh = functools.partial(_refresh_when_detailed, obj.name_full)
-            bpy.app.timers.register(refresh, first_interval=0.2)
-    X = b.deformer.solve(blend(transforms, b.levels))
+    T = blend(transforms, b.levels)
+    pending = b.deformer.detail_pending
+    if pending and final:
+        b.deformer.wait_for_detail()
+        pending = False
+    quick = (not final and not pending and obj.specdeform.quick_drags
+             and b.full_ms > QUICK_ABOVE_MS)
+    if quick and isinstance(b.used, slice):  # straight into the positions, no temporary
+        b.deformer.preview(T, out=b.positions)
+    else:
+        b.positions[b.used] = b.deformer.preview(T) if quick else b.deformer.solve(T)
     solved = time.perf_counter()
+    if not quick and not pending:
+        b.full_ms = 1e3 * (solved - start)
+    b.exact = not quick and not pending
     b.last = transforms  # before writing: the write triggers the depsgraph handler again
-    b.positions[b.used] = X
     mesh_helpers.set_coordinates(obj.data, b.positions)
-    b.status.pop("error", None)
-    b.status["iterations"] = b.deformer.report.get("iterations", 0)
-    b.status["solve_ms"] = 1e3 * (solved - start)
-    b.status["write_ms"] = 1e3 * (time.perf_counter() - solved)
+    st = b.status
+    st.pop("error", None)
+    if quick:
+        st["detail"] = "details as displacements while the target moves"
+    elif pending:
+        st["detail"] = "details as displacements until the transfer is ready"
+    else:
+        st.pop("detail", None)
+    if not b.exact:
+        b.moved = solved
+        if not b.finishing:
+            b.finishing = True
+            bpy.app.timers.register(functools.partial(_finish_later, obj.name_full),
+                                    first_interval=0.2 if pending else SETTLE_S)
+    st["iterations"] = b.deformer.report.get("iterations", 0)
+    st["solve_ms"] = 1e3 * (solved - start)
+    st["quick"] = quick
+    st["write_ms"] = 1e3 * (time.perf_counter() - solved)
 
 
 @dataclass
@@ -316,6 +373,7 @@ def bind(obj, r, job):
             unconstrained=s.unconstrained,
             constraint_weight=s.constraint_weight,
             background_transfer=True,  # the details as displacements until it is factored
+            float32_basis=True,  # Blender's coordinates are float32: half the inverse transform
         )
         d.set_selection(handles=r.groups, fixed=r.fixed)
     except sd.Error as e:

@@ -95,6 +95,7 @@ class SPECDEFORM_OT_apply(bpy.types.Operator):
         return _poll_mesh(context) and context.object.specdeform.bound
 
     def execute(self, context):
+        binding.finish(context.object)
         binding.release(context.object)
         return {"FINISHED"}
 

@@ -100,4 +100,11 @@ class SpecdeformSettings(bpy.types.PropertyGroup):
         default=1e5,
         min=1e-6,
     )
+    quick_drags: BoolProperty(
+        name="Quick drags",
+        description="Where a full update takes over 50 ms: while a target moves, the details are "
+        "added as displacements, and the full details follow once it rests for a quarter second "
+        "(renders and bakes always have them)",
+        default=True,
+    )
     bound: BoolProperty(name="Bound", description="The mesh follows the target", default=False)

@@ -74,6 +74,7 @@ class VIEW3D_PT_specdeform(bpy.types.Panel):
         col.prop(s, "detail")
         col.prop(s, "unconstrained", text="Free")
         col.prop(s, "constraint_weight")
+        layout.prop(s, "quick_drags")
         row = layout.row(align=True)
         row.operator("specdeform.bind")
         row.operator("specdeform.unbind")

@@ -171,6 +171,43 @@ only.)")
           R"(The deformed mesh (n, 3) for one 4 x 4 affine transform per handle group (a list, a
 (k, 4, 4) array, or one matrix for one group).)")
       .def(
+          "preview",
+          [](Deformer& d, py::handle transforms, py::handle vertices,
+             py::handle out) -> py::object {
+            const std::vector<Eigen::Affine3d> t = to_transforms(transforms);
+            const int n = d.deformer->mesh().num_vertices();
+            if (!out.is_none()) {
+              if (!vertices.is_none()) throw InputError("preview: out is for every vertex");
+              auto buffer = py::cast<py::array>(out);
+              if (!py::isinstance<py::array_t<float>>(buffer) || buffer.ndim() != 2 ||
+                  buffer.shape(0) != n || buffer.shape(1) != 3 || !buffer.writeable() ||
+                  !(buffer.flags() & py::array::c_style)) {
+                throw InputError("preview: out must be a writeable C-contiguous float32 (" +
+                                 std::to_string(n) + ", 3) array");
+              }
+              Eigen::Map<FloatVertices> rows(static_cast<float*>(buffer.mutable_data()), n, 3);
+              py::gil_scoped_release release;
+              const std::lock_guard lock(d.mutex);
+              d.deformer->preview(t, rows);
+              return py::reinterpret_borrow<py::object>(out);
+            }
+            std::vector<int> at;
+            if (!vertices.is_none()) at = to_indices(vertices, n, "vertices");
+            Vertices result;
+            {
+              py::gil_scoped_release release;
+              const std::lock_guard lock(d.mutex);
+              result = vertices.is_none() ? d.deformer->preview(t) : d.deformer->preview(t, at);
+            }
+            return to_array(std::move(result));
+          },
+          py::arg("transforms"), py::arg("vertices") = py::none(), py::arg("out") = py::none(),
+          R"(solve()'s frame with the details added as displacements, at `vertices` (k,) in
+their order, or at every vertex (n, 3): the cost of the reduced solve and the inverse transform
+only, for drags (a Transfer's solve follows once the handles rest). out: a float32 (n, 3)
+C-contiguous array written in place and returned (a vertex buffer: nothing the mesh's size is
+allocated per frame). base_miss and deformed_base stay those of the last solve().)")
+      .def(
           "base_miss",
           [](Deformer& d) {
             const std::lock_guard lock(d.mutex);

@@ -227,19 +227,64 @@ Eigen::MatrixX3d SpectralDeformer::solve_coefficients(
   return base_targets;
 }
 
-void SpectralDeformer::inverse_transform(Vertices& deformed) const {
+void SpectralDeformer::inverse_transform(const Vertices& origin, Vertices& deformed) const {
   if (!reduced_) {
-    deformed = base_ + state_.x;
+    deformed = origin + state_.x;
   } else if (options_.float32_basis) {
-    detail::add_basis_product(base_, basis32_, state_.x, deformed);
+    detail::add_basis_product(origin, basis32_, state_.x, deformed);
   } else {
-    detail::add_basis_product(base_, solve_basis_->basis, state_.x, deformed);
+    detail::add_basis_product(origin, solve_basis_->basis, state_.x, deformed);
   }
+  keep_free_pieces(origin, deformed);
+}
+
+template <typename Out>
+void SpectralDeformer::keep_free_pieces(const Vertices& origin, Out& deformed) const {
   // Free pieces stay exactly where they are (the solvers hold them only as well as soft
   // constraints do), then follow the deformed surface around them.
   const std::vector<int>& constrained = constrained_.vertices;
   for (size_t i = constrained_.first_free; i < constrained.size(); ++i)
-    deformed.row(constrained[i]) = base_.row(constrained[i]);
+    deformed.row(constrained[i]) = origin.row(constrained[i]).template cast<typename Out::Scalar>();
+}
+
+Vertices SpectralDeformer::preview(const std::vector<Eigen::Affine3d>& transforms) {
+  Clock total;
+  solve_coefficients(transforms);
+  Clock clock;
+  Vertices out;
+  if (follow_) {  // the pieces' motions are the deformed base's
+    inverse_transform(base_, out);
+    follow_->apply(follow_->motions(base_, out), base_, out);
+    out += mesh_.V - base_;
+  } else {
+    inverse_transform(mesh_.V, out);  // x + H c = s' + (x - s) in one pass
+  }
+  frame_.inverse_transform = clock.lap();
+  frame_.total = total.lap();
+  return out;
+}
+
+void SpectralDeformer::preview(const std::vector<Eigen::Affine3d>& transforms,
+                               Eigen::Ref<FloatVertices> out) {
+  if (out.rows() != mesh_.num_vertices()) {
+    throw InputError("preview: an output of " + std::to_string(out.rows()) + " rows for " +
+                     std::to_string(mesh_.num_vertices()) + " vertices");
+  }
+  if (follow_ || !reduced_) {  // through the frame in double precision
+    out = preview(transforms).cast<float>();
+    return;
+  }
+  Clock total;
+  solve_coefficients(transforms);
+  Clock clock;
+  if (options_.float32_basis) {
+    detail::add_basis_product(mesh_.V, basis32_, state_.x, out);
+  } else {
+    detail::add_basis_product(mesh_.V, solve_basis_->basis, state_.x, out);
+  }
+  keep_free_pieces(mesh_.V, out);
+  frame_.inverse_transform = clock.lap();
+  frame_.total = total.lap();
 }
 
 Vertices SpectralDeformer::preview(const std::vector<Eigen::Affine3d>& transforms,
@@ -249,24 +294,17 @@ Vertices SpectralDeformer::preview(const std::vector<Eigen::Affine3d>& transform
       throw InputError("preview: vertex " + std::to_string(v) + " out of range");
     }
   }
-  Clock clock, total;
+  if (follow_) return preview(transforms)(vertices, Eigen::all);
+  Clock total;
   solve_coefficients(transforms);
-  clock.lap();
+  Clock clock;
   Vertices out(vertices.size(), 3);
-  if (follow_) {
-    Vertices deformed;
-    inverse_transform(deformed);
-    follow_->apply(follow_->motions(base_, deformed), base_, deformed);
-    for (size_t k = 0; k < vertices.size(); ++k)
-      out.row(k) = mesh_.V.row(vertices[k]) + deformed.row(vertices[k]) - base_.row(vertices[k]);
-  } else {
-    for (size_t k = 0; k < vertices.size(); ++k) {
-      const int v = vertices[k];
-      if (reduced_) {
-        out.row(k) = mesh_.V.row(v) + solve_basis_->basis.row(v) * state_.x;
-      } else {
-        out.row(k) = mesh_.V.row(v) + state_.x.row(v);
-      }
+  for (size_t k = 0; k < vertices.size(); ++k) {
+    const int v = vertices[k];
+    if (reduced_) {
+      out.row(k) = mesh_.V.row(v) + solve_basis_->basis.row(v) * state_.x;
+    } else {
+      out.row(k) = mesh_.V.row(v) + state_.x.row(v);
     }
   }
   frame_.inverse_transform = clock.lap();
@@ -278,7 +316,7 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
   Clock total;
   const Eigen::MatrixX3d base_targets = solve_coefficients(transforms);
   Clock clock;
-  inverse_transform(deformed_base_);
+  inverse_transform(base_, deformed_base_);
   frame_.inverse_transform = clock.lap();
   const std::vector<int>& constrained = constrained_.vertices;
   base_miss_ = ConstraintError{};

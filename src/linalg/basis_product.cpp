@@ -11,11 +11,12 @@ namespace {
 
 constexpr int kBlockRows = 256;
 
-// Rows [begin, end) of out = base + H C, all column-major with leading dimension n.
-template <typename Scalar>
+// Rows [begin, end) of base + H C (base and H column-major with leading dimension n), each
+// row's three sums handed to store(row, x, y, z).
+template <typename Scalar, typename Store>
 [[gnu::always_inline]] inline void add_rows(const double* base, const Scalar* H, Eigen::Index n,
-                                            int m, const double* C, double* out, Eigen::Index begin,
-                                            Eigen::Index end) {
+                                            int m, const double* C, Eigen::Index begin,
+                                            Eigen::Index end, Store store) {
   for (Eigen::Index r0 = begin; r0 < end; r0 += kBlockRows) {
     const int rows = static_cast<int>(std::min<Eigen::Index>(kBlockRows, end - r0));
     double acc[3][kBlockRows] = {};
@@ -29,35 +30,52 @@ template <typename Scalar>
         acc[2][r] += v * c2;
       }
     }
-    for (int d = 0; d < 3; ++d)
-      for (int r = 0; r < rows; ++r) out[d * n + r0 + r] = base[d * n + r0 + r] + acc[d][r];
+    for (int r = 0; r < rows; ++r) {
+      const Eigen::Index i = r0 + r;
+      store(i, base[i] + acc[0][r], base[n + i] + acc[1][r], base[2 * n + i] + acc[2][r]);
+    }
   }
 }
 
+// Output: column-major doubles (leading dimension n), or rows of three floats `stride` apart.
+struct Doubles {
+  double* out;
+  Eigen::Index n;
+  void operator()(Eigen::Index i, double x, double y, double z) const {
+    out[i] = x;
+    out[n + i] = y;
+    out[2 * n + i] = z;
+  }
+};
+struct FloatRows {
+  float* out;
+  Eigen::Index stride;
+  void operator()(Eigen::Index i, double x, double y, double z) const {
+    float* row = out + i * stride;
+    row[0] = static_cast<float>(x);
+    row[1] = static_cast<float>(y);
+    row[2] = static_cast<float>(z);
+  }
+};
+
 // Compiled for AVX2 as well, chosen at run time: no -march flag is needed.
-__attribute__((target_clones("avx2", "default"))) void add_rows_double(
-    const double* base, const double* H, Eigen::Index n, int m, const double* C, double* out,
-    Eigen::Index begin, Eigen::Index end) {
-  add_rows(base, H, n, m, C, out, begin, end);
+template <typename Scalar, typename Store>
+__attribute__((target_clones("avx2", "default"))) void add_rows_kernel(
+    const double* base, const Scalar* H, Eigen::Index n, int m, const double* C, Eigen::Index begin,
+    Eigen::Index end, Store store) {
+  add_rows(base, H, n, m, C, begin, end, store);
 }
 
-__attribute__((target_clones("avx2", "default"))) void add_rows_float(
-    const double* base, const float* H, Eigen::Index n, int m, const double* C, double* out,
-    Eigen::Index begin, Eigen::Index end) {
-  add_rows(base, H, n, m, C, out, begin, end);
-}
-
-template <typename Matrix, typename Kernel>
+template <typename Matrix, typename Store>
 void add_product(const Eigen::MatrixX3d& base, const Matrix& H, const Eigen::MatrixX3d& C,
-                 Eigen::MatrixX3d& out, Kernel kernel) {
+                 Store store) {
   if (C.rows() != H.cols() || base.rows() != H.rows()) {
     throw InputError("basis product: the sizes do not match");
   }
-  out.resize(H.rows(), 3);
   const Eigen::Index blocks = (H.rows() + kBlockRows - 1) / kBlockRows;
   split_in_two(blocks, [&](Eigen::Index begin, Eigen::Index end) {
-    kernel(base.data(), H.data(), H.rows(), static_cast<int>(H.cols()), C.data(), out.data(),
-           begin * kBlockRows, std::min(end * kBlockRows, H.rows()));
+    add_rows_kernel(base.data(), H.data(), H.rows(), static_cast<int>(H.cols()), C.data(),
+                    begin * kBlockRows, std::min(end * kBlockRows, H.rows()), store);
   });
 }
 
@@ -65,12 +83,26 @@ void add_product(const Eigen::MatrixX3d& base, const Matrix& H, const Eigen::Mat
 
 void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXd& H,
                        const Eigen::MatrixX3d& C, Eigen::MatrixX3d& out) {
-  add_product(base, H, C, out, add_rows_double);
+  out.resize(H.rows(), 3);
+  add_product(base, H, C, Doubles{out.data(), H.rows()});
 }
 
 void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXf& H,
                        const Eigen::MatrixX3d& C, Eigen::MatrixX3d& out) {
-  add_product(base, H, C, out, add_rows_float);
+  out.resize(H.rows(), 3);
+  add_product(base, H, C, Doubles{out.data(), H.rows()});
+}
+
+void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXd& H,
+                       const Eigen::MatrixX3d& C, Eigen::Ref<FloatVertices> out) {
+  if (out.rows() != H.rows()) throw InputError("basis product: the sizes do not match");
+  add_product(base, H, C, FloatRows{out.data(), out.outerStride()});
+}
+
+void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXf& H,
+                       const Eigen::MatrixX3d& C, Eigen::Ref<FloatVertices> out) {
+  if (out.rows() != H.rows()) throw InputError("basis product: the sizes do not match");
+  add_product(base, H, C, FloatRows{out.data(), out.outerStride()});
 }
 
 }  // namespace specdeform::detail

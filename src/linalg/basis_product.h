@@ -2,10 +2,13 @@
 // 3), the inverse manifold-harmonics transform of one deformation frame. Memory-bound (H is read
 // once): rows are processed in blocks whose three accumulators stay in the L1 cache, and the
 // blocks are split between two threads. Plain loops rather than a BLAS call, which would pack
-// (copy) all of H first.
+// (copy) all of H first. The result into column-major doubles, or into rows of three floats
+// (the layout of a front end's vertex buffer, written in place).
 #pragma once
 
 #include <Eigen/Core>
+
+#include "specdeform/mesh/triangle_mesh.h"
 
 namespace specdeform::detail {
 
@@ -14,5 +17,10 @@ void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXd& H,
                        const Eigen::MatrixX3d& C, Eigen::MatrixX3d& out);
 void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXf& H,
                        const Eigen::MatrixX3d& C, Eigen::MatrixX3d& out);
+// `out` has n rows (InputError otherwise).
+void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXd& H,
+                       const Eigen::MatrixX3d& C, Eigen::Ref<FloatVertices> out);
+void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXf& H,
+                       const Eigen::MatrixX3d& C, Eigen::Ref<FloatVertices> out);
 
 }  // namespace specdeform::detail

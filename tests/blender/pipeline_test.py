@@ -11,6 +11,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 import zipfile
 
 PART = sys.argv[sys.argv.index("--") + 1]
@@ -276,8 +277,9 @@ def check_handles():
     print(f"weight 0.5: {half:.1e} of the diagonal from half way")
     assert half <= 0.005, half
 
-    # In the window (not a render), a pose solved while the transfer is being factored shows its
-    # details as displacements; the timer then solves it again with the transfer.
+    # In the window (not a render), the mesh shows its details as displacements while the
+    # transfer is factored, and while a target moves where a full update is slow (Quick drags);
+    # a timer then solves the pose again in full once the targets rest.
     binding = support.binding
     must_be_final, binding._must_be_final = binding._must_be_final, lambda: False
     assert bpy.ops.specdeform.unbind() == {"FINISHED"}
@@ -285,12 +287,35 @@ def check_handles():
     support.move(first, up)
     b = binding.binding(obj)
     b.deformer.wait_for_detail()
-    assert binding._refresh_when_detailed(obj.name_full) is None and "detail" not in b.status
-    direct = b.deformer.solve(binding.blend(binding.local_transforms(obj), b.levels))
-    miss = np.abs(support.evaluated(obj) - direct).max() / diagonal
+    time.sleep(binding.SETTLE_S)
+    assert binding._finish_later(obj.name_full) is None and "detail" not in b.status and b.exact
+
+    def direct_miss():
+        T = binding.blend(binding.local_transforms(obj), b.levels)
+        return np.abs(support.evaluated(obj) - b.deformer.solve(T)).max() / diagonal
+
+    miss = direct_miss()
     print(f"the transfer's pose after the timer: {miss:.1e} of the diagonal from a direct solve")
     assert miss <= 1e-5, miss
+    b.full_ms = binding.QUICK_ABOVE_MS + 1  # as on a large mesh
+    up[:3, 3] = (0, 0, 0.4)
+    support.move(first, up)
+    T = binding.blend(binding.local_transforms(obj), b.levels)
+    assert b.status["quick"] and not b.exact and "moves" in b.status["detail"], b.status
+    quick = np.abs(support.evaluated(obj) - b.deformer.preview(T)).max() / diagonal
+    print(f"a quick drag's pose: {quick:.1e} of the diagonal from the library's preview")
+    assert quick <= 1e-5 and direct_miss() > 1e-4, quick
+    assert 0 < binding._finish_later(obj.name_full) <= binding.SETTLE_S  # it moved just now
+    time.sleep(binding.SETTLE_S)
+    assert binding._finish_later(obj.name_full) is None and b.exact and direct_miss() <= 1e-5
+    # A render (or Apply, Bake Pose: finish) solves a quick pose in full at once.
+    b.full_ms = binding.QUICK_ABOVE_MS + 1
+    up[:3, 3] = (0, 0, 0.3)
+    support.move(first, up)
+    assert not b.exact
     binding._must_be_final = must_be_final
+    binding.update(obj, b)
+    assert b.exact and direct_miss() <= 1e-5
 
 
 def main():

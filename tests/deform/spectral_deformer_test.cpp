@@ -73,8 +73,10 @@ TEST(SpectralDeformer, IdentityReproducesTheInput) {
 }
 
 // A preview is solve()'s frame with the details as displacements, at the vertices asked for,
-// in their order: equal to a Displacement deformer's solve() there, for each energy and solver;
-// and where free pieces follow, their vertices move as solve() moves the pieces' bases.
+// in their order, or at all (also into a float buffer): equal to a Displacement deformer's
+// solve() there, for each energy and solver (with the single-precision basis or output, to
+// their rounding); and where free pieces follow, their vertices move as solve() moves the
+// pieces' bases.
 TEST(SpectralDeformer, APreviewIsTheFrameWithDisplacements) {
   const BarScene s = bar_scene(6);
   const double diagonal = bounding_box_diagonal(s.mesh.V);
@@ -91,12 +93,32 @@ TEST(SpectralDeformer, APreviewIsTheFrameWithDisplacements) {
                                 o);
       deformer.set_selection(s.selection);
       const Vertices preview = deformer.preview({turn}, at);
+      const Vertices whole = deformer.preview({turn});
+      FloatVertices buffer(s.mesh.num_vertices(), 3);
+      deformer.preview({turn}, buffer);
       const Vertices full = deformer.solve({turn});
+      EXPECT_LT((buffer.cast<double>() - full).cwiseAbs().maxCoeff(), 1e-6 * diagonal);
       ASSERT_EQ(preview.rows(), static_cast<Eigen::Index>(at.size()));
       EXPECT_LT((preview - full(at, Eigen::all)).cwiseAbs().maxCoeff(), 1e-9 * diagonal)
           << static_cast<int>(solver) << " " << static_cast<int>(energy);
+      EXPECT_LT((whole - full).cwiseAbs().maxCoeff(), 1e-9 * diagonal)
+          << static_cast<int>(solver) << " " << static_cast<int>(energy);
     }
   }
+  DeformOptions single;
+  single.float32_basis = true;
+  SpectralDeformer transfer(s.mesh, h, single);
+  transfer.set_selection(s.selection);
+  const Vertices quick = transfer.preview({turn});
+  FloatVertices buffer(s.mesh.num_vertices(), 3);
+  transfer.preview({turn}, buffer);
+  transfer.solve({turn});
+  const Vertices expected_quick = transfer.deformed_base() + s.mesh.V - transfer.base();
+  EXPECT_LT((quick - expected_quick).cwiseAbs().maxCoeff(), 1e-5 * diagonal);
+  EXPECT_LT((buffer.cast<double>() - expected_quick).cwiseAbs().maxCoeff(), 1e-5 * diagonal);
+  FloatVertices short_buffer(3, 3);
+  EXPECT_THROW(transfer.preview({turn}, short_buffer), InputError);
+  EXPECT_GT((quick - s.mesh.V).norm(), 0.05);
   // A sphere beside the bar, with no handle or fixed vertex: it follows the bar's base.
   TriangleMesh two = test::concatenate(s.mesh, make_icosphere(1));
   const int sphere = s.mesh.num_vertices();
@@ -107,10 +129,14 @@ TEST(SpectralDeformer, APreviewIsTheFrameWithDisplacements) {
   deformer.set_selection(s.selection);
   const std::vector<int> on_sphere = {sphere, sphere + 41};
   const Vertices preview = deformer.preview({turn}, on_sphere);
+  const Vertices whole = deformer.preview({turn});
+  FloatVertices rows(two.num_vertices(), 3);
+  deformer.preview({turn}, rows);
   const Vertices full = deformer.solve({turn});  // the base only (DetailMethod::None)
-  const Vertices expected = full(on_sphere, Eigen::all) + two.V(on_sphere, Eigen::all) -
-                            deformer.base()(on_sphere, Eigen::all);
-  EXPECT_LT((preview - expected).cwiseAbs().maxCoeff(), 1e-9 * diagonal);
+  const Vertices expected = full + two.V - deformer.base();
+  EXPECT_LT((preview - expected(on_sphere, Eigen::all)).cwiseAbs().maxCoeff(), 1e-9 * diagonal);
+  EXPECT_LT((whole - expected).cwiseAbs().maxCoeff(), 1e-9 * diagonal);
+  EXPECT_LT((rows.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-6 * diagonal);
   EXPECT_GT((preview - two.V(on_sphere, Eigen::all)).norm(), 0.05);
   EXPECT_THROW(deformer.preview({turn}, {two.num_vertices()}), InputError);
 }

@@ -409,3 +409,42 @@ def test_basis_cache_file_is_the_file_manifold_harmonics_writes(tmp_path, bar):
     assert specdeform.basis_cache_file(V, F, 8, cache=tmp_path, eigensolver="multilevel") == path
     other = specdeform.basis_cache_file(V, F, 9, cache=tmp_path, eigensolver="multilevel")
     assert other.name.endswith("-m9-lumped-multilevel.sdbasis")
+
+
+def test_preview_is_the_frame_with_the_details_as_displacements(bar):
+    """preview(T) at every vertex, or at some: the pose's base plus x - s, as a Displacement
+    deformer solves it; solve() afterwards still gives the transfer's frame."""
+    V, F = bar
+    basis = specdeform.manifold_harmonics(V, F, 20)
+    handle, fixed = V[:, 0] > 3.5, V[:, 0] < 0.5
+    T = turn(50, V[handle].mean(axis=0))
+    transfer = specdeform.SpectralDeformer(V, F, basis=basis)
+    displaced = specdeform.SpectralDeformer(V, F, basis=basis, detail="displacement")
+    for d in (transfer, displaced):
+        d.set_selection([handle], fixed)
+    quick, expected = transfer.preview(T), displaced.solve(T)
+    assert quick.shape == V.shape
+    np.testing.assert_allclose(quick, expected, atol=1e-9)
+    at = [len(V) - 1, 0, 5]
+    np.testing.assert_allclose(transfer.preview(T, at), expected[at], atol=1e-9)
+    assert relative_difference(transfer.solve(T), quick, V) > 1e-4  # the details turned
+    with pytest.raises(specdeform.InputError):
+        transfer.preview(T, [len(V)])
+
+
+def test_preview_into_a_float32_buffer(bar):
+    """preview(T, out=buffer) writes the frame into the caller's float32 rows and returns them;
+    anything else for out is an InputError."""
+    V, F = bar
+    d = specdeform.SpectralDeformer(V, F, basis=specdeform.manifold_harmonics(V, F, 20))
+    d.set_selection([V[:, 0] > 3.5], V[:, 0] < 0.5)
+    T = turn(50, V[V[:, 0] > 3.5].mean(axis=0))
+    buffer = np.zeros(V.shape, np.float32)
+    assert d.preview(T, out=buffer) is buffer
+    assert relative_difference(buffer, d.preview(T), V) < 1e-6
+    for wrong in (np.zeros(V.shape), np.zeros((len(V) - 1, 3), np.float32),
+                  np.zeros((3, len(V)), np.float32).T):
+        with pytest.raises(specdeform.InputError, match="out must be"):
+            d.preview(T, out=wrong)
+    with pytest.raises(specdeform.InputError, match="every vertex"):
+        d.preview(T, [0], out=buffer)

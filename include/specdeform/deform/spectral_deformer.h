@@ -97,6 +97,13 @@ class SpectralDeformer {
   // those of the last solve(); InputError for a vertex out of range.
   Vertices preview(const std::vector<Eigen::Affine3d>& transforms,
                    const std::vector<int>& vertices);
+  // The same at every vertex (n x 3): solve()'s frame without the cost of its details (a
+  // Transfer's right-hand side and back-substitution), for a front end that shows drags at full
+  // resolution and solves once the handles rest. float32_basis applies.
+  Vertices preview(const std::vector<Eigen::Affine3d>& transforms);
+  // The same written into `out` (n rows, InputError otherwise), a front end's own vertex buffer:
+  // nothing the size of the mesh is allocated, frame after frame.
+  void preview(const std::vector<Eigen::Affine3d>& transforms, Eigen::Ref<FloatVertices> out);
 
   // Error of `result` (a solve() output) against the targets of the last solve(): 0 where the
   // details meet them exactly (transfer, frames, displacement anchor the constrained vertices).
@@ -149,8 +156,13 @@ class SpectralDeformer {
   // The reduced (or spatial) solve of a frame: state_, arap_report_ and frame_.reduced_solve.
   // Returns the smooth base's targets of the constrained vertices.
   Eigen::MatrixX3d solve_coefficients(const std::vector<Eigen::Affine3d>& transforms);
-  // deformed = base_ + H c (or + d), free pieces put back where they were.
-  void inverse_transform(Vertices& deformed) const;
+  // deformed = origin + H c (or + d), free pieces' rows those of origin (base_: the deformed
+  // base; mesh_.V: the details added as displacements).
+  void inverse_transform(const Vertices& origin, Vertices& deformed) const;
+  // The free pieces' rows of `deformed` set to those of origin (unconstrained Keep, or before
+  // they follow).
+  template <typename Out>
+  void keep_free_pieces(const Vertices& origin, Out& deformed) const;
   // The solvers in `basis`; ARAP's clusters on the `moving` vertices (n flags; empty: all).
   void build_solvers(std::shared_ptr<const ManifoldHarmonics> basis,
                      const std::vector<char>& moving = {});

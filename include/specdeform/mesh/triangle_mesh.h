@@ -13,6 +13,8 @@ namespace specdeform {
 
 using Vertices = Eigen::Matrix<double, Eigen::Dynamic, 3>;
 using Faces = Eigen::Matrix<int, Eigen::Dynamic, 3>;
+// Positions as renderers and modelling tools keep them: rows of three floats.
+using FloatVertices = Eigen::Matrix<float, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 struct TriangleMesh {
   Vertices V;

@@ -1,0 +1,43 @@
+#include "linalg/basis_product.h"
+
+#include <gtest/gtest.h>
+
+#include "specdeform/exceptions.h"
+
+namespace specdeform {
+namespace {
+
+// base + H C against Eigen's product, for both bases and both outputs: row counts that are not a
+// multiple of the blocks (and one smaller than a block), and rows of floats with a padded stride.
+TEST(BasisProduct, MatchesEigensProduct) {
+  for (const int n : {1, 37, 256, 1000, 4097}) {
+    const Eigen::MatrixXd H = Eigen::MatrixXd::Random(n, 13);
+    const Eigen::MatrixXf H32 = H.cast<float>();
+    const Eigen::MatrixX3d base = Eigen::MatrixX3d::Random(n, 3),
+                           C = Eigen::MatrixX3d::Random(13, 3);
+    const Eigen::MatrixX3d expected = base + H * C;
+    const Eigen::MatrixX3d expected32 = base + H32.cast<double>() * C;
+    Eigen::MatrixX3d out;
+    detail::add_basis_product(base, H, C, out);
+    EXPECT_LT((out - expected).cwiseAbs().maxCoeff(), 1e-12) << n;
+    detail::add_basis_product(base, H32, C, out);
+    EXPECT_LT((out - expected32).cwiseAbs().maxCoeff(), 1e-12) << n;
+    Eigen::Matrix<float, Eigen::Dynamic, 4, Eigen::RowMajor> padded =
+        Eigen::Matrix<float, Eigen::Dynamic, 4, Eigen::RowMajor>::Constant(n, 4, 7.0f);
+    Eigen::Map<FloatVertices, 0, Eigen::OuterStride<>> rows(padded.data(), n, 3,
+                                                            Eigen::OuterStride<>(4));
+    detail::add_basis_product(base, H, C, rows);
+    EXPECT_LT((rows.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-5) << n;
+    detail::add_basis_product(base, H32, C, rows);
+    EXPECT_LT((rows.cast<double>() - expected32).cwiseAbs().maxCoeff(), 1e-5) << n;
+    EXPECT_TRUE((padded.col(3).array() == 7.0f).all()) << n;  // the padding left alone
+  }
+  FloatVertices wrong(3, 3);
+  const Eigen::MatrixXd H = Eigen::MatrixXd::Zero(4, 2);
+  EXPECT_THROW(detail::add_basis_product(Eigen::MatrixX3d::Zero(4, 3), H,
+                                         Eigen::MatrixX3d::Zero(2, 3), wrong),
+               InputError);
+}
+
+}  // namespace
+}  // namespace specdeform
