@@ -20,6 +20,7 @@
 #include "specdeform/deform/scene.h"
 #include "specdeform/mesh/generate.h"
 #include "specdeform/spectral/basis_cache.h"
+#include "specdeform/spectral/basis_store.h"
 
 namespace specdeform::server {
 
@@ -113,7 +114,7 @@ Json save_and_report(const std::filesystem::path& file, const ManifoldHarmonics&
   const Clock::time_point start = Clock::now();
   Json out = {{"type", "saving"}, {"file", file.filename().string()}, {"done", true}};
   try {
-    save_basis(file, basis, mesh);
+    save_basis(file, basis, mesh, cache_precision(basis));
     out["bytes"] = std::filesystem::file_size(file);
     out["error"] = "";
   } catch (const std::exception& e) {

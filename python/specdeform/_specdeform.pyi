@@ -168,7 +168,7 @@ def save_basis(
     V: npt.ArrayLike,
     F: npt.ArrayLike,
     *,
-    float32: bool = False,
+    float32: bool | None = None,
     mass: _Mass | None = None,
 ) -> None: ...
 def harmonics_forward(

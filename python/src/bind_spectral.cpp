@@ -197,18 +197,22 @@ reads, or writes when it does not exist: to compute a basis without a cache and 
   m.def(
       "save_basis",
       [](const std::filesystem::path& path, py::handle basis, py::handle V, py::handle F,
-         bool float32, std::optional<std::string> mass) {
+         std::optional<bool> float32, std::optional<std::string> mass) {
         check_writable(path);
         const TriangleMesh mesh = to_mesh(V, F);
         const auto h =
             to_basis(basis, mesh, mass ? std::optional(mass_from_name(*mass)) : std::nullopt, {});
         py::gil_scoped_release release;
-        save_basis(path, *h, mesh, float32 ? BasisPrecision::Float32 : BasisPrecision::Float64);
+        save_basis(path, *h, mesh,
+                   !float32   ? cache_precision(*h)
+                   : *float32 ? BasisPrecision::Float32
+                              : BasisPrecision::Float64);
       },
       py::arg("path"), py::arg("basis"), py::arg("V"), py::arg("F"), py::kw_only(),
-      py::arg("float32") = false, py::arg("mass") = py::none(),
+      py::arg("float32") = py::none(), py::arg("mass") = py::none(),
       "Writes (evals, evecs) of the mesh (V, F) as a basis file the CLI and the editor read; "
-      "float32 halves it. Atomic.");
+      "float32 halves it (default: float32 for an approximate, multilevel basis, as the caches "
+      "keep it; float64 for an exact one). Atomic.");
 
   m.def(
       "harmonics_forward",

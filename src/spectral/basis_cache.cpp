@@ -1,5 +1,6 @@
 #include "specdeform/spectral/basis_cache.h"
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <fstream>
@@ -171,10 +172,15 @@ ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMe
   }
   if (ok && scalar == 8) {
     ok = static_cast<bool>(file.read(reinterpret_cast<char*>(out.basis.data()), 8 * size_t(n) * m));
-  } else if (ok) {
-    Eigen::MatrixXf H(n, m);
-    ok = static_cast<bool>(file.read(reinterpret_cast<char*>(H.data()), 4 * size_t(n) * m));
-    out.basis = H.cast<double>();
+  } else if (ok) {  // through a small buffer: no float copy of the whole basis
+    std::vector<float> chunk(size_t{1} << 18);
+    double* to = out.basis.data();
+    for (size_t left = size_t(n) * m; ok && left > 0;) {
+      const size_t count = std::min(left, chunk.size());
+      ok = static_cast<bool>(file.read(reinterpret_cast<char*>(chunk.data()), 4 * count));
+      to = std::copy_n(chunk.begin(), count, to);
+      left -= count;
+    }
   }
   if (!ok) throw InputError(name + ": truncated basis file");
   return out;

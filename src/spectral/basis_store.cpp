@@ -71,6 +71,10 @@ std::filesystem::path cached_basis_file(const TriangleMesh& mesh, const Manifold
   return folder / basis_file_name(mesh, o);
 }
 
+BasisPrecision cache_precision(const ManifoldHarmonics& basis) {
+  return basis.approximate ? BasisPrecision::Float32 : BasisPrecision::Float64;
+}
+
 ObtainedBasis obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonicsOptions& o,
                            const std::filesystem::path& cache) {
   const auto start = std::chrono::steady_clock::now();
@@ -101,7 +105,7 @@ ObtainedBasis obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonicsOpti
       out.warning = "the basis is less accurate than asked: " + residual_summary(h);
     } else if (!out.file.empty()) {
       try {
-        save_basis(out.file, h, mesh);
+        save_basis(out.file, h, mesh, cache_precision(h));
       } catch (const std::exception& e) {
         std::cerr << "specdeform: warning: basis not cached: " << e.what() << "\n";
       }

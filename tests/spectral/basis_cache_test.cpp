@@ -171,5 +171,29 @@ TEST_F(BasisCache, APieceByPieceBasisServesItsOwnM) {
   EXPECT_EQ(anew.harmonics->basis.cols(), 32);
 }
 
+// A cache keeps an exact basis in float64 (read back bit for bit) and an approximate (multilevel)
+// one in float32: half the file, its entries within float32's rounding.
+TEST_F(BasisCache, KeepsAMultilevelBasisInSinglePrecision) {
+  const TriangleMesh sphere = make_icosphere(4);
+  ManifoldHarmonicsOptions o;
+  o.num_modes = 16;
+  const ObtainedBasis exact = obtain_basis(sphere, o, dir_);
+  o.solver = EigenSolver::Multilevel;
+  o.policy.multilevel_min_samples = 1;  // N = 160 coarse functions
+  std::filesystem::remove(exact.file);
+  const ObtainedBasis multilevel = obtain_basis(sphere, o, dir_);
+  ASSERT_TRUE(multilevel.harmonics->approximate);
+  EXPECT_EQ(cache_precision(*exact.harmonics), BasisPrecision::Float64);
+  EXPECT_EQ(cache_precision(*multilevel.harmonics), BasisPrecision::Float32);
+  const ObtainedBasis back = obtain_basis(sphere, o, dir_);
+  ASSERT_TRUE(back.loaded);
+  const Eigen::MatrixXd& H = multilevel.harmonics->basis;
+  EXPECT_NE(back.harmonics->basis, H);
+  EXPECT_LT((back.harmonics->basis - H).cwiseAbs().maxCoeff(), 1e-6 * H.cwiseAbs().maxCoeff());
+  const double entry_bytes =
+      static_cast<double>(std::filesystem::file_size(back.file)) / static_cast<double>(H.size());
+  EXPECT_LT(entry_bytes, 5.0);
+}
+
 }  // namespace
 }  // namespace specdeform

@@ -18,6 +18,7 @@
 #include <string>
 
 #include "specdeform/mesh/triangle_mesh.h"
+#include "specdeform/spectral/basis_cache.h"
 #include "specdeform/spectral/manifold_harmonics.h"
 
 namespace specdeform {
@@ -36,6 +37,11 @@ std::filesystem::path cached_basis_file(const TriangleMesh& mesh,
                                         const ManifoldHarmonicsOptions& options,
                                         const std::filesystem::path& folder);
 
+// The precision a cache keeps `basis` in: float32 for an approximate (multilevel) basis, whose
+// own error (its residuals, 1e-4 and more) is far above float32's rounding (6e-8 of each entry):
+// half the file, half its write; float64 for an exact basis.
+BasisPrecision cache_precision(const ManifoldHarmonics& basis);
+
 struct ObtainedBasis {
   std::shared_ptr<const ManifoldHarmonics> harmonics;  // options.num_modes pairs (more on
                                                        // several pieces)
@@ -48,9 +54,9 @@ struct ObtainedBasis {
 // The basis from `cache` (a file, or an existing folder: the file of basis_file_name() in it)
 // when it holds one for the request; otherwise computed (options.progress is called, and may
 // throw to abandon it) and, when it converged, written there (a failed write is a warning on
-// stderr, not an error). No cache: computed. Throws InputError for a named file of another mesh,
-// other operators, too few pairs or the wrong kind, SolverError for a computed basis whose
-// residual exceeds kUsableResidual without converging.
+// stderr, not an error; in cache_precision()). No cache: computed. Throws InputError for a named
+// file of another mesh, other operators, too few pairs or the wrong kind, SolverError for a
+// computed basis whose residual exceeds kUsableResidual without converging.
 ObtainedBasis obtain_basis(const TriangleMesh& mesh, const ManifoldHarmonicsOptions& options,
                            const std::filesystem::path& cache = {});
 
