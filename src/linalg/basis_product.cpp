@@ -58,24 +58,39 @@ struct FloatRows {
   }
 };
 
-// Compiled for AVX2 as well, chosen at run time: no -march flag is needed.
-template <typename Scalar, typename Store>
-__attribute__((target_clones("avx2", "default"))) void add_rows_kernel(
-    const double* base, const Scalar* H, Eigen::Index n, int m, const double* C, Eigen::Index begin,
-    Eigen::Index end, Store store) {
+// Compiled for AVX2 as well, chosen at run time: no -march flag is needed (one function per
+// basis and output type: clang multiversions no templates).
+__attribute__((target_clones("avx2", "default"))) void add_rows_double(
+    const double* base, const double* H, Eigen::Index n, int m, const double* C, Eigen::Index begin,
+    Eigen::Index end, Doubles store) {
+  add_rows(base, H, n, m, C, begin, end, store);
+}
+__attribute__((target_clones("avx2", "default"))) void add_rows_float(
+    const double* base, const float* H, Eigen::Index n, int m, const double* C, Eigen::Index begin,
+    Eigen::Index end, Doubles store) {
+  add_rows(base, H, n, m, C, begin, end, store);
+}
+__attribute__((target_clones("avx2", "default"))) void add_rows_double_to_floats(
+    const double* base, const double* H, Eigen::Index n, int m, const double* C, Eigen::Index begin,
+    Eigen::Index end, FloatRows store) {
+  add_rows(base, H, n, m, C, begin, end, store);
+}
+__attribute__((target_clones("avx2", "default"))) void add_rows_float_to_floats(
+    const double* base, const float* H, Eigen::Index n, int m, const double* C, Eigen::Index begin,
+    Eigen::Index end, FloatRows store) {
   add_rows(base, H, n, m, C, begin, end, store);
 }
 
-template <typename Matrix, typename Store>
+template <typename Matrix, typename Store, typename Kernel>
 void add_product(const Eigen::MatrixX3d& base, const Matrix& H, const Eigen::MatrixX3d& C,
-                 Store store) {
+                 Store store, Kernel kernel) {
   if (C.rows() != H.cols() || base.rows() != H.rows()) {
     throw InputError("basis product: the sizes do not match");
   }
   const Eigen::Index blocks = (H.rows() + kBlockRows - 1) / kBlockRows;
   split_in_two(blocks, [&](Eigen::Index begin, Eigen::Index end) {
-    add_rows_kernel(base.data(), H.data(), H.rows(), static_cast<int>(H.cols()), C.data(),
-                    begin * kBlockRows, std::min(end * kBlockRows, H.rows()), store);
+    kernel(base.data(), H.data(), H.rows(), static_cast<int>(H.cols()), C.data(),
+           begin * kBlockRows, std::min(end * kBlockRows, H.rows()), store);
   });
 }
 
@@ -84,25 +99,25 @@ void add_product(const Eigen::MatrixX3d& base, const Matrix& H, const Eigen::Mat
 void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXd& H,
                        const Eigen::MatrixX3d& C, Eigen::MatrixX3d& out) {
   out.resize(H.rows(), 3);
-  add_product(base, H, C, Doubles{out.data(), H.rows()});
+  add_product(base, H, C, Doubles{out.data(), H.rows()}, add_rows_double);
 }
 
 void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXf& H,
                        const Eigen::MatrixX3d& C, Eigen::MatrixX3d& out) {
   out.resize(H.rows(), 3);
-  add_product(base, H, C, Doubles{out.data(), H.rows()});
+  add_product(base, H, C, Doubles{out.data(), H.rows()}, add_rows_float);
 }
 
 void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXd& H,
                        const Eigen::MatrixX3d& C, Eigen::Ref<FloatVertices> out) {
   if (out.rows() != H.rows()) throw InputError("basis product: the sizes do not match");
-  add_product(base, H, C, FloatRows{out.data(), out.outerStride()});
+  add_product(base, H, C, FloatRows{out.data(), out.outerStride()}, add_rows_double_to_floats);
 }
 
 void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXf& H,
                        const Eigen::MatrixX3d& C, Eigen::Ref<FloatVertices> out) {
   if (out.rows() != H.rows()) throw InputError("basis product: the sizes do not match");
-  add_product(base, H, C, FloatRows{out.data(), out.outerStride()});
+  add_product(base, H, C, FloatRows{out.data(), out.outerStride()}, add_rows_float_to_floats);
 }
 
 }  // namespace specdeform::detail

@@ -57,6 +57,20 @@ try {
       }).observe(status, { childList: true, characterData: true, subtree: true });
     });
   });
+  // The socket's messages, [seconds from navigation, '>' sent or '<' received, type, bytes]: where
+  // the time between the server's replies and the page's reactions goes.
+  const messages = [];
+  const opened = Date.now();
+  const kindOf = (payload) => {
+    if (typeof payload === 'string') return JSON.parse(payload).type ?? 'text';
+    return `binary ${payload.readUInt32LE(0)}`;
+  };
+  page.on('websocket', (ws) => {
+    const record = (dir) => ({ payload }) => messages.push(
+      [+((Date.now() - opened) / 1000).toFixed(3), dir, kindOf(payload), payload.length]);
+    ws.on('framesent', record('>'));
+    ws.on('framereceived', record('<'));
+  });
   await page.goto(url);
   const api = (fn, arg) => page.evaluate(fn, arg);
   const now = () => api(() => performance.now());
@@ -187,6 +201,7 @@ try {
   // Where the page's main thread was held (tasks over 50 ms), up to the drag's detail.
   result.long_tasks_s = (await api(() => window.longTasks)).sort((a, b) => b[1] - a[1]).slice(0, 8)
     .map(([t, d]) => [+(t / 1000).toFixed(2), +(d / 1000).toFixed(2)]);
+  result.messages_s = messages.filter(([t]) => t <= result.first_drag_drawn_s + 0.5);
   const moved = await api(() => window.specdeformEditor.transforms()[0]);
   check(Math.hypot(moved[3], moved[7], moved[11]) > 0, 'the drag moved the handle');
   check((await api(() => window.specdeformEditor.stats.framesDrawn)) > drawnBefore, 'the drag was drawn');
