@@ -174,15 +174,20 @@ struct EditorServer::Impl {
     }
   }
 
-  void attach(const std::shared_ptr<Connection>& c) {
+  // Returns whether the connection got the mesh being prepared (its hello then skips it: the
+  // rest of the build is sent to it as it happens).
+  bool attach(const std::shared_ptr<Connection>& c) {
     std::shared_ptr<Connection> previous;
+    bool has_mesh = false;
     {
       std::lock_guard lock(connection_mutex);
       previous = std::exchange(connection, c);
       for (const std::string& m : preparing) c->send(true, m);
+      has_mesh = !preparing.empty();
       if (!progress.empty()) c->send(false, progress);
     }
     if (previous) previous->close("another editor window connected");
+    return has_mesh;
   }
 
   void detach(const std::shared_ptr<Connection>& c) {
@@ -236,8 +241,10 @@ struct EditorServer::Impl {
     ws.read_message_max(config.max_message_bytes);
     co_await ws.async_accept(req, use_awaitable);
     auto c = std::make_shared<Connection>(std::move(ws));
-    attach(c);
-    mailbox.push([this] { session->handle(false, R"({"type":"hello"})"); }, false);
+    // The connection's one greeting (the page sends none): the edit, once the worker is free.
+    const std::string hello =
+        attach(c) ? R"({"type":"hello","has_mesh":true})" : R"({"type":"hello"})";
+    mailbox.push([this, hello] { session->handle(false, hello); }, false);
     try {
       for (;;) {
         beast::flat_buffer buffer;

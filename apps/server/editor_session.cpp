@@ -306,7 +306,7 @@ void EditorSession::text_message(std::string_view message) {
   if (!state_) throw InputError("no mesh is open");
   State& s = *state_;
   if (type == "hello") {
-    resend_edit();
+    resend_edit(!j.value("has_mesh", false));
     return send_state();
   }
   if (type == "settings") return change_settings(message);
@@ -689,9 +689,9 @@ void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
   save_in_background();
 }
 
-void EditorSession::resend_edit() {
+void EditorSession::resend_edit(bool mesh) {
   if (!state_) return;
-  send_mesh();
+  if (mesh) send_mesh();
   send_ready();
   send_selection();
   if (state_->has_handles) solve_and_send();

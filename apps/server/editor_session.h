@@ -5,7 +5,9 @@
 //
 // Text messages (JSON objects with a "type"):
 //   browser -> server
-//     {"type": "hello"}              everything again (a new connection)
+//     {"type": "hello"}              everything again (the server's own, for each connection;
+//                                    "has_mesh": true when the connection got the mesh being
+//                                    prepared: all but the mesh)
 //     {"type": "settings", "modes": m, "energy": "linear|arap", "ks": x, "kb": x,
 //      "detail": "none|displacement|frames|transfer", "constraints": "soft|hard",
 //      "unconstrained": "follow|keep|error", "influence": r (of the diagonal, 0: none),
@@ -154,7 +156,9 @@ class EditorSession {
   void send_mesh();  // with the file's appearance and textures, if it has them
   void send_mesh(const TriangleMesh& rest, const std::optional<Appearance>& look,
                  const LoadedMesh& loaded);
-  void resend_edit();  // the mesh, settings, selection and frame of the open edit, if any
+  // The mesh (unless the connection has it), settings, selection and frame of the open edit, if
+  // any.
+  void resend_edit(bool mesh = true);
   void progress(std::string_view stage, double fraction, bool cancellable);
   // The basis just computed written to the cache on a thread of its own ("saving" messages).
   void save_in_background();

@@ -360,7 +360,7 @@ TEST_F(EditorSessionTest, ArapIsAnEnergyOfThePanel) {
 }
 
 // A new connection ("hello") gets the whole edit back: mesh, settings, groups with their
-// transforms and flags, undo, and the deformed frame.
+// transforms and flags, undo, and the deformed frame (the mesh only where it lacks it).
 TEST_F(EditorSessionTest, HelloRestoresTheEdit) {
   session_->handle(false, R"({"type": "settings", "kb": 3})");
   GroupSelection s = plain(selection_);
@@ -376,6 +376,14 @@ TEST_F(EditorSessionTest, HelloRestoresTheEdit) {
   EXPECT_EQ(back.selection.fixed, selection_.fixed);
   EXPECT_TRUE(back.transforms[0].matrix().isApprox(s.transforms[0].matrix()));
   EXPECT_TRUE(last_text("state")["undo"]);
+  for (int i : selection_.handles[0]) EXPECT_NEAR(last_frame()(i, 1), rest_(i, 1) + 0.1, 1e-5);
+  EXPECT_NE(last_binary(Tag::Mesh), nullptr);
+  // A connection that got the mesh while it was prepared: everything but the mesh.
+  sent_.clear();
+  session_->handle(false, R"({"type": "hello", "has_mesh": true})");
+  EXPECT_EQ(text_types(), (std::vector<std::string>{"ready", "state"}));
+  EXPECT_EQ(last_binary(Tag::Mesh), nullptr);
+  EXPECT_NE(last_binary(Tag::SelectionResult), nullptr);
   for (int i : selection_.handles[0]) EXPECT_NEAR(last_frame()(i, 1), rest_(i, 1) + 0.1, 1e-5);
 }
 

@@ -107,7 +107,7 @@ export type ServerText =
 // ---------------------------------------------------------------- JSON, browser -> server
 
 export type ClientText =
-  | { type: 'hello' | 'open_demo' | 'commit' | 'undo' | 'redo' | 'apply_pose' | 'export_scene' | 'cancel' }
+  | { type: 'open_demo' | 'commit' | 'undo' | 'redo' | 'apply_pose' | 'export_scene' | 'cancel' }
   | ({ type: 'settings' } & Partial<Settings> & { modes?: number })
   | { type: 'preview'; vertices: number }
   | { type: 'export_mesh'; format?: ExportFormat }; // none: the opened file's own

@@ -244,8 +244,7 @@ export class EditorState {
       this.restoreChecked = !this.wasOpen; // after a reconnection: does the server still have the edit?
       this.wasOpen = true;
       this.awaitingStates = 1;
-      this.selectionsInFlight = 0;
-      this.connection.send({ type: 'hello' });
+      this.selectionsInFlight = 0; // the server greets the connection ("hello"): no request
     } else if (s.kind === 'closed') {
       // The banner stays while disconnected; the log says when it started.
       if (this.phase.kind !== 'disconnected') this.note(`disconnected: ${s.reason}`);
