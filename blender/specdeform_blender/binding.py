@@ -189,17 +189,19 @@ def update(obj, b, depsgraph=None, full=False):
 
 @dataclass
 class Request:
-    """What Bind reads from the object and its settings before the basis is computed."""
+    """What Bind reads from the object and its settings: the mesh (request), then, while the
+    worker computes the basis, the handles and fixed vertices (select)."""
 
     rest: np.ndarray
     used: np.ndarray
+    renumber: np.ndarray  # each vertex's index in the deformer's numbering (-1: in no face)
     V: np.ndarray
     F: np.ndarray
-    groups: list  # vertex indices (deformer's numbering) of each of the scene's handle groups
-    levels: list  # (handle, weight) of each
-    fixed: np.ndarray
     modes: int
     eigensolver: str
+    groups: list = None  # vertex indices (deformer's numbering) of each handle group of the scene
+    levels: list = None  # (handle, weight) of each
+    fixed: np.ndarray = None
 
 
 def _check(obj):
@@ -235,7 +237,7 @@ def _shared(names, members):
 
 
 def request(obj):
-    """Bind's input from `obj` (its saved rest when it is bound already), or an error message."""
+    """Bind's mesh from `obj` (its saved rest when it is bound already), or an error message."""
     s = obj.specdeform
     problem = _check(obj)
     if problem:
@@ -252,23 +254,44 @@ def request(obj):
         return f"Modes is {s.modes}, more than the mesh's {len(used)} vertices: lower Modes"
     renumber = np.full(len(rest), -1, np.int64)
     renumber[used] = np.arange(len(used))
-    F = renumber[F]
+    return Request(rest, used, renumber, rest[used].astype(np.float64),
+                   renumber[F].astype(np.int32), s.modes, s.eigensolver)
+
+
+def select(obj, r):
+    """The request's handle groups, their weights' levels and the fixed vertices, from the vertex
+    groups (read vertex by vertex: a third of a second at 692k vertices, which Bind spends while
+    the worker computes the basis); an error message, or None."""
+    s = obj.specdeform
     names = [group for group, _, _ in handles(obj)] + [s.fixed_group] * bool(s.fixed_group)
     weights = mesh_helpers.group_weights(obj, set(names))
     members = {}
     for name, (indices, w) in weights.items():
-        keep = renumber[indices] >= 0
+        keep = r.renumber[indices] >= 0
         if not keep.any():
             return f"vertex group '{name}' holds no vertex of a face"
-        members[name] = (renumber[indices][keep], w[keep])
+        members[name] = (r.renumber[indices][keep], w[keep])
     problem = _shared(names, members)
     if problem:
         return problem
     split = [x for h, (group, _, _) in enumerate(handles(obj)) for x in _levels(h, *members[group])]
-    fixed = members[s.fixed_group][0] if s.fixed_group else np.empty(0, np.int64)
-    return Request(rest, used, rest[used].astype(np.float64), F.astype(np.int32),
-                   [g for g, _ in split], [level for _, level in split], fixed, s.modes,
-                   s.eigensolver)
+    r.groups, r.levels = [g for g, _ in split], [level for _, level in split]
+    r.fixed = members[s.fixed_group][0] if s.fixed_group else np.empty(0, np.int64)
+    return None
+
+
+def start(obj):
+    """Bind's request and its basis job (started before the vertex groups are read), or an error
+    message."""
+    r = request(obj)
+    if isinstance(r, str):
+        return r
+    job = BasisJob(r)
+    problem = select(obj, r)
+    if problem:
+        job.cancel()
+        return problem
+    return r, job
 
 
 class _Cancelled(Exception):
@@ -404,10 +427,10 @@ def bind(obj, r, job):
 def bind_now(obj, report=None):
     """Bind's whole pipeline on this thread (scripts, the load handler, leaving Edit Mode);
     report(text) is called every second with the progress. Returns an error message, or None."""
-    r = request(obj)
-    if isinstance(r, str):
-        return r
-    job = BasisJob(r)
+    started = start(obj)
+    if isinstance(started, str):
+        return started
+    r, job = started
     while not job.done:
         job.join(1.0)
         if report and not job.done:

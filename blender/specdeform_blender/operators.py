@@ -29,10 +29,10 @@ class SPECDEFORM_OT_bind(bpy.types.Operator):
         """From the panel: the basis on a worker thread, progress in the status bar, Esc to
         cancel."""
         self.obj = context.object
-        self.r = binding.request(self.obj)
-        if isinstance(self.r, str):
-            return self._done(self.r)
-        self.job = binding.BasisJob(self.r)
+        started = binding.start(self.obj)
+        if isinstance(started, str):
+            return self._done(started)
+        self.r, self.job = started
         wm = context.window_manager
         wm.progress_begin(0, 100)
         self.timer = wm.event_timer_add(0.1, window=context.window)
