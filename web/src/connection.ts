@@ -22,7 +22,11 @@ export class Connection {
   private retryTimer: number | undefined;
   status: ConnectionStatus = { kind: 'connecting', attempt: 0 };
 
-  constructor(private readonly url: string, private readonly on: ConnectionEvents) {}
+  // The events go to `on`, set by whoever reads them (the socket may be opened first: nothing
+  // arrives before the task that opens it ends).
+  on: ConnectionEvents = { status: () => {}, text: () => {}, binary: () => {} };
+
+  constructor(private readonly url: string) {}
 
   get open(): boolean {
     return this.status.kind === 'open';

@@ -18,7 +18,8 @@ export type WorkerRequest =
 
 export type WorkerReply =
   | { kind: 'frame'; slot: Slot; seq: number; positions: Float32Array; normals: Float32Array;
-      lookNormals: Float32Array | null; measures: Measures | null }
+      lookNormals: Float32Array | null }
+  | { kind: 'measures'; seq: number; measures: Measures | null } // of the full frame `seq`
   | { kind: 'brush'; id: number; vertices: Uint32Array };
 
 // The brush's graph and the measures' rest lengths are made when first used, not before the
@@ -66,12 +67,14 @@ self.onmessage = (e: MessageEvent<WorkerRequest>) => {
       groupNormals(positions, look.vertex, look.group, look.indices, look.sums, lookNormals);
     }
     const copy = positions.slice();
-    // The rest shape has nothing to measure.
-    const moved = m.slot === 'full' && d.some((x) => x !== 0);
-    if (moved) mesh.measures ??= new MeshMeasures(mesh.indices, mesh.rest);
-    const measures = moved ? mesh.measures!.of(positions) : null;
     const transfer = lookNormals ? [copy.buffer, normals.buffer, lookNormals.buffer] : [copy.buffer, normals.buffer];
-    post({ kind: 'frame', slot: m.slot, seq: m.seq, positions: copy, normals, lookNormals, measures }, transfer);
+    post({ kind: 'frame', slot: m.slot, seq: m.seq, positions: copy, normals, lookNormals }, transfer);
+    if (m.slot !== 'full') return;
+    // Measured once the frame is on its way (the first takes a second at a million vertices);
+    // the rest shape has nothing to measure.
+    const moved = d.some((x) => x !== 0);
+    if (moved) mesh.measures ??= new MeshMeasures(mesh.indices, mesh.rest);
+    post({ kind: 'measures', seq: m.seq, measures: moved ? mesh.measures!.of(positions) : null }, []);
   } else {
     const mesh = meshes.full;
     if (!mesh) return;

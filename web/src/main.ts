@@ -3,14 +3,19 @@
 // and the picture script).
 import * as THREE from 'three';
 import './style.css';
+import { Connection } from './connection';
 import { Interaction } from './interaction';
 import { Panel } from './panel';
 import * as P from './protocol';
 import { EditorState, rowMajor, stats } from './state';
 import { Viewer } from './viewer';
 
+// The socket first: the server sends the mesh while the page makes its view (a second without
+// a GPU).
+const connection = new Connection(`ws://${location.host}/ws`);
+connection.connect();
 const view = document.getElementById('view')!;
-const state = new EditorState(new Viewer(view));
+const state = new EditorState(new Viewer(view), connection);
 const interaction = new Interaction(state, view);
 new Panel(state, interaction);
 interaction.setTool('handle');
@@ -35,6 +40,7 @@ const viewer = state.viewer;
   restPositions: () => Array.from(state.rest),
   positions: () => Array.from(viewer.positions()),
   labels: () => Array.from(state.labels),
+  counts: () => state.counts(), // of the labels painted
   transforms: () => state.groups.map((g) => rowMajor(g.transform)),
   vertexOnScreen: (v: number) => viewer.toScreen(new THREE.Vector3().fromArray(viewer.positions(), 3 * v)),
   diagonal: () => state.diagonal,
@@ -74,4 +80,3 @@ const viewer = state.viewer;
   }),
 };
 
-state.connect();

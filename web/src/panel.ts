@@ -69,7 +69,7 @@ export class Panel {
     document.querySelectorAll<HTMLButtonElement>('[data-tool]').forEach((b) =>
       b.addEventListener('click', () => this.ui.setTool(b.dataset.tool as Tool)),
     );
-    $('reconnect').addEventListener('click', () => s.connect());
+    $('reconnect').addEventListener('click', () => s.connection.connect());
     $('cancel').addEventListener('click', () => {
       s.connection.send({ type: 'cancel' });
       $('cancel').textContent = 'Cancelling…';
@@ -313,8 +313,8 @@ export class Panel {
     })();
     status.textContent = text;
     status.className = cls;
-    $('hint').textContent = s.paintable ? this.nextStep() : '';
     const c = s.counts();
+    $('hint').textContent = s.paintable ? this.nextStep(c) : '';
     $('counts').textContent = r && editable
       ? `handles: ${c.handles.toLocaleString()} vertices in ${c.groups} group${c.groups === 1 ? '' : 's'} · ` +
         `fixed: ${c.fixed.toLocaleString()} · pinned: ${c.pinned.toLocaleString()}` +
@@ -382,8 +382,7 @@ export class Panel {
   }
 
   // What to do next, from what is selected.
-  private nextStep(): string {
-    const c = this.s.counts();
+  private nextStep(c: ReturnType<EditorState['counts']>): string {
     const tool = HINTS[this.ui.tool];
     if (c.handles === 0) return `${tool} Next: paint a handle (1), paint what must stay (2), then drag it (4).`;
     if (c.fixed + c.pinned === 0) return `${tool} Next: paint what must stay (Fixed, 2), or drag now (Move, 4).`;

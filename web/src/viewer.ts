@@ -49,8 +49,7 @@ export class Viewer {
   private renderQueued = false;
 
   constructor(private readonly container: HTMLElement) {
-    // A software renderer (no GPU) spends most of a frame on multisampling: it goes without.
-    this.renderer = new THREE.WebGLRenderer({ antialias: !softwareRenderer(), preserveDrawingBuffer: true });
+    this.renderer = makeRenderer();
     this.renderer.setPixelRatio(window.devicePixelRatio);
     container.appendChild(this.renderer.domElement);
     this.scene.background = new THREE.Color(0xf2f3f5);
@@ -400,32 +399,33 @@ export class Viewer {
     this.requestRender();
   }
 
-  // Milliseconds to draw the full mesh once, waited for (reading a pixel back waits for the
-  // drawing; gl.finish does not in Chromium): what decides whether drags show the preview.
-  // Called once the mesh has been drawn (its upload and shaders are done).
-  measureDraw(): number {
-    const gl = this.renderer.getContext();
-    const pixel = new Uint8Array(4);
-    const draw = () => {
-      this.renderer.render(this.scene, this.camera);
-      gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
-    };
-    const coarse = this.coarse.visible;
-    this.coarse.visible = false;
-    this.surface.visible = true;
-    // The median of three, or one draw when it is slow (each blocks the page: 0.5-1 s for 1.4M
-    // triangles without a GPU, which the opening's server work needs the cores for).
-    const times: number[] = [];
-    for (let i = 0; i < 3 && !(times[0] > kSlowDrawMs); ++i) {
-      const t = performance.now();
-      draw();
-      times.push(performance.now() - t);
-    }
-    this.coarse.visible = coarse;
-    this.surface.visible = !coarse;
-    this.drawMs = times.sort((a, b) => a - b)[Math.floor(times.length / 2)];
-    return this.drawMs;
+  // Milliseconds until the GPU (or the software renderer's threads) has done what was submitted
+  // so far, without waiting for it: a fence, polled every few milliseconds while the page goes on
+  // taking events. Called right after a draw, it times that draw.
+  timeSubmitted(): Promise<number> {
+    const gl = this.renderer.getContext() as WebGL2RenderingContext;
+    const start = performance.now();
+    const fence = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
+    if (!fence) return Promise.resolve(0); // a lost context
+    gl.flush();
+    return new Promise((resolve) => {
+      const poll = () => {
+        if (gl.getSyncParameter(fence, gl.SYNC_STATUS) !== gl.SIGNALED) return void setTimeout(poll, 2);
+        gl.deleteSync(fence);
+        resolve(performance.now() - start);
+      };
+      setTimeout(poll);
+    });
   }
+
+  // The next draw, timed (timeSubmitted).
+  timeNextDraw(): Promise<number> {
+    return new Promise((resolve) => {
+      this.afterDraw.push(() => void this.timeSubmitted().then(resolve));
+      this.requestRender();
+    });
+  }
+  private afterDraw: (() => void)[] = [];
 
   // Draws on the next animation frame. A slow draw (the full large mesh without a GPU) is
   // followed by as long without one, so that pointer events, which wait for the frame being drawn, still
@@ -437,6 +437,7 @@ export class Viewer {
       this.renderQueued = false;
       this.renderer.render(this.scene, this.camera);
       this.lastDraw = performance.now();
+      for (const f of this.afterDraw.splice(0)) f();
       this.drawAxes();
       this.onRendered();
     });
@@ -445,7 +446,7 @@ export class Viewer {
     if (wait > 0) setTimeout(draw, wait);
     else draw();
   }
-  drawMs = 0; // the full mesh's draw, measured by measureDraw
+  drawMs = 0; // the full mesh's draw (the state times it)
   private lastDraw = -Infinity;
 
   // The axis widget: the world axes as the camera sees them, +X red, +Y green, +Z blue.
@@ -513,10 +514,18 @@ export class Viewer {
 // Draws slower than this are spaced out (requestRender).
 const kSlowDrawMs = 50;
 
-function softwareRenderer(): boolean {
-  const gl = document.createElement('canvas').getContext('webgl2');
-  const info = gl?.getExtension('WEBGL_debug_renderer_info');
-  const name = info ? String(gl!.getParameter(info.UNMASKED_RENDERER_WEBGL)) : '';
-  gl?.getExtension('WEBGL_lose_context')?.loseContext();
-  return /swiftshader|llvmpipe|software/i.test(name);
+// The renderer, without multisampling where the context is a software renderer (no GPU: it
+// would spend most of a frame on it), with it otherwise. One context is made there (a second
+// costs 0.7 s at the opening), two on a GPU.
+function makeRenderer(): THREE.WebGLRenderer {
+  const canvas = document.createElement('canvas');
+  const attributes = { alpha: false, depth: true, stencil: false, premultipliedAlpha: true, preserveDrawingBuffer: true };
+  const context = canvas.getContext('webgl2', { ...attributes, antialias: false });
+  const info = context?.getExtension('WEBGL_debug_renderer_info');
+  const name = info ? String(context!.getParameter(info.UNMASKED_RENDERER_WEBGL)) : '';
+  if (context && /swiftshader|llvmpipe|software/i.test(name)) {
+    return new THREE.WebGLRenderer({ canvas, context, ...attributes });
+  }
+  context?.getExtension('WEBGL_lose_context')?.loseContext();
+  return new THREE.WebGLRenderer({ ...attributes, antialias: true });
 }
