@@ -4,7 +4,8 @@
 //    while the basis computes (when it still computes: a fast machine may finish first); the
 //    server takes the selection painted meanwhile once the basis is ready;
 //  - every loading stage has its label, and none reads "100%" while something else runs;
-//  - the first drag as soon as the basis is ready: its detailed result drawn;
+//  - the first drag as soon as the basis is ready: its detailed result drawn, and the CPU time
+//    the server, Chromium and the harness used up to then (the two cores' floor);
 //  - the basis is saved in the background after "ready", and the page says so;
 //  - pointer moves coalesce: a burst of moves within one frame is acted on once;
 //  - a 5-point stroke: how long it takes to play and to be applied after the release;
@@ -14,7 +15,7 @@
 //
 // Prints one JSON line of timings (from the page's start: navigation) and writes loading.json to
 // --out. Timings are reported, not checked.
-import { mkdtempSync, rmSync, writeFileSync, mkdirSync } from 'node:fs';
+import { mkdtempSync, readdirSync, readFileSync, rmSync, writeFileSync, mkdirSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { basename, dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -35,6 +36,32 @@ const { values: args } = parseArgs({
 // What the page's state says is polled this often (ms), not once per drawn frame (Playwright's
 // default): a draw of a million triangles without a GPU takes most of a second.
 const kPollMs = 50;
+
+// CPU seconds used so far by the server, by Chromium's processes and by this script (Linux's
+// /proc, 100 ticks a second): the work the two cores were given.
+function cpuSeconds(serverPid) {
+  const ticks = (pid) => {
+    try {
+      const stat = readFileSync(`/proc/${pid}/stat`, 'utf8');
+      const fields = stat.slice(stat.lastIndexOf(')') + 2).split(' '); // from the 3rd field
+      return (Number(fields[11]) + Number(fields[12])) / 100; // utime + stime
+    } catch {
+      return 0; // gone meanwhile
+    }
+  };
+  // Chromium's processes by --type: gpu-process (SwiftShader's drawing), renderer (the page and
+  // its workers), browser (none), utility and zygotes.
+  const chromium = {};
+  for (const pid of readdirSync('/proc').filter((p) => /^\d+$/.test(p))) {
+    let args = '';
+    try { args = readFileSync(`/proc/${pid}/cmdline`, 'utf8'); } catch { continue; }
+    if (!/^\S*chrom/.test(args)) continue;
+    const type = /--type=([\w-]+)/.exec(args)?.[1] ?? 'browser';
+    chromium[type] = (chromium[type] ?? 0) + ticks(pid);
+  }
+  const own = process.cpuUsage();
+  return { server: ticks(serverPid), ...chromium, harness: (own.user + own.system) / 1e6 };
+}
 
 const cacheDir = mkdtempSync(join(tmpdir(), 'specdeform-cache-'));
 const editArgs = [...(args.mesh ? [args.mesh] : []), ...(args.modes ? ['-m', args.modes] : [])];
@@ -75,6 +102,7 @@ try {
     ws.on('framesent', record('>'));
     ws.on('framereceived', record('<'));
   });
+  const cpuAtOpening = cpuSeconds(editor.server.pid);
   await page.goto(url);
   const api = (fn, arg) => page.evaluate(fn, arg);
   const now = () => api(() => performance.now());
@@ -198,6 +226,11 @@ try {
   await page.waitForFunction((t) => window.specdeformEditor.stats.detailedDrawn > t, upOnPage,
     { timeout: 120000 }).catch(() => {});
   result.first_drag_whole_mesh_drawn_s = (await api(() => window.specdeformEditor.stats.detailedDrawn)) / 1000;
+  // The work done by then: were the two cores ever idle?
+  const cpu = cpuSeconds(editor.server.pid);
+  result.cpu_to_first_drag_s = Object.fromEntries(Object.keys(cpu).map((k) => [k, +(cpu[k] - (cpuAtOpening[k] ?? 0)).toFixed(1)]));
+  result.cpu_to_first_drag_s.server_before_opening = +cpuAtOpening.server.toFixed(1);
+  result.draws_to_first_drag = await api(() => window.specdeformEditor.draws());
   await waitReady(120000);
   result.drag_12_steps_play_s = (up - td) / 1000;
   result.drag_detailed_after_release_s = (Date.now() - up) / 1000;

@@ -37,6 +37,7 @@ const viewer = state.viewer;
     fixed: state.server.fixed,
   },
   stats,
+  draws: () => viewer.draws,
   restPositions: () => Array.from(state.rest),
   positions: () => Array.from(viewer.positions()),
   labels: () => Array.from(state.labels),

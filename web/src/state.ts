@@ -50,6 +50,7 @@ const kPreviewMs = 8;
 // A mesh's first draw slower than this is slow whatever its upload took (25 MB at a million
 // vertices: a few milliseconds on a GPU).
 const kUploadMs = 100;
+const kProgressMs = 500;
 
 export class EditorState {
   phase: Phase = { kind: 'connecting' };
@@ -107,11 +108,15 @@ export class EditorState {
     viewer.onRendered = () => this.onRendered();
   }
 
+  private progressShown = -Infinity; // when the page last showed a change (changed())
+  private progressLater: number | undefined; // a change of the progress to show then
+
   subscribe(listener: () => void): void {
     this.listeners.push(listener);
   }
 
   changed(): void {
+    this.progressShown = performance.now();
     for (const l of this.listeners) l();
   }
 
@@ -263,9 +268,20 @@ export class EditorState {
 
   private onText(m: P.ServerText): void {
     switch (m.type) {
-      case 'progress':
+      case 'progress': {
+        const stage = this.phase.kind === 'loading' ? this.phase.stage : null;
         this.phase = { kind: 'loading', stage: m.stage, fraction: m.fraction, cancellable: m.cancellable };
+        // A stage's progress is shown every kProgressMs at most: each change of the page costs
+        // a software renderer a composite of the whole window (30% of a core at 10 a second).
+        if (stage === m.stage && performance.now() - this.progressShown < kProgressMs) {
+          this.progressLater ??= window.setTimeout(() => {
+            this.progressLater = undefined;
+            this.changed();
+          }, kProgressMs);
+          return;
+        }
         break;
+      }
       case 'ready':
         this.adoptReady(m);
         if (this.phase.kind !== 'busy' || this.phase.expects === 'ready') this.phase = { kind: 'ready' };
@@ -476,7 +492,7 @@ export class EditorState {
     let ms = await this.viewer.timeSubmitted();
     if (ms > kFullDrawBudgetMs && ms < kUploadMs) ms = await this.viewer.timeNextDraw();
     if (this.indices !== mesh) return; // another mesh came meanwhile
-    this.drawMs = this.viewer.drawMs = ms;
+    this.drawMs = ms;
     const n = this.rest.length / 3;
     const wanted = this.drawMs > kFullDrawBudgetMs;
     const size = Math.round(Math.max(2000, Math.min(n / 3, (n * kPreviewMs) / this.drawMs)));

@@ -139,6 +139,7 @@ export class Viewer {
     const request: BvhRequest = { id: ++this.bvhRequest, indices: indices.slice(), positions: positions.slice() };
     this.bvhWorker.postMessage(request, [request.indices.buffer, request.positions.buffer]);
     this.coarse.visible = false;
+    this.shaded = false;
     if (!keepCamera) this.look.set(null); // another mesh: its look, if any, follows
     this.showSurface();
     if (!keepCamera) {
@@ -186,11 +187,13 @@ export class Viewer {
     return this.look.mesh.visible;
   }
 
+  // The mesh is drawn once its normals have come (setPositions), not before, unshaded.
   private showSurface(): void {
     const look = this.look.present && this.lookShown;
-    this.look.mesh.visible = look;
-    this.surface.visible = !look;
+    this.look.mesh.visible = this.shaded && look;
+    this.surface.visible = this.shaded && !look;
   }
+  private shaded = false;
 
   // A full frame: positions and their normals (computed off the main thread), and the file
   // look's normals when it has one.
@@ -203,6 +206,7 @@ export class Viewer {
     nrm.needsUpdate = true;
     this.bvhStale = true;
     this.coarse.visible = false;
+    this.shaded = true;
     this.look.setPositions(positions, lookNormals);
     this.showSurface();
     this.previewLabel.hidden = true;
@@ -437,7 +441,13 @@ export class Viewer {
       this.renderQueued = false;
       this.renderer.render(this.scene, this.camera);
       this.lastDraw = performance.now();
+      ++this.draws;
       for (const f of this.afterDraw.splice(0)) f();
+      // The full mesh's draws, timed one at a time, pace the next.
+      if (!this.coarse.visible && !this.timingDraw) {
+        this.timingDraw = true;
+        void this.timeSubmitted().then((ms) => ([this.drawMs, this.timingDraw] = [ms, false]));
+      }
       this.drawAxes();
       this.onRendered();
     });
@@ -446,7 +456,9 @@ export class Viewer {
     if (wait > 0) setTimeout(draw, wait);
     else draw();
   }
-  drawMs = 0; // the full mesh's draw (the state times it)
+  drawMs = 0; // the full mesh's last timed draw
+  private timingDraw = false;
+  draws = 0; // made so far, of whatever is shown
   private lastDraw = -Infinity;
 
   // The axis widget: the world axes as the camera sees them, +X red, +Y green, +Z blue.

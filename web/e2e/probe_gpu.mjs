@@ -1,0 +1,17 @@
+import { readdirSync, readFileSync } from 'node:fs';
+import { resolve } from 'node:path';
+import { launchChromium, startEditor } from './harness.mjs';
+const editor = startEditor(resolve('../build/bin/specdeform'), process.argv.slice(2), 0);
+const url = await editor.url;
+const browser = await launchChromium();
+const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+const cpu = () => { const o = {}; for (const pid of readdirSync('/proc').filter((p) => /^\d+$/.test(p))) { let a = ''; try { a = readFileSync(`/proc/${pid}/cmdline`, 'utf8'); } catch { continue; } if (!/^\S*chrom/.test(a)) continue; const t = /--type=([\w-]+)/.exec(a)?.[1] ?? 'browser'; const st = readFileSync(`/proc/${pid}/stat`, 'utf8'); const f = st.slice(st.lastIndexOf(')') + 2).split(' '); o[t] = (o[t] ?? 0) + (+f[11] + +f[12]) / 100; } return o; };
+const diff = (a, b) => Object.fromEntries(Object.keys(b).map((k) => [k, +(b[k] - (a[k] ?? 0)).toFixed(2)]));
+await page.addInitScript(() => { window.rafs = []; const r = window.requestAnimationFrame.bind(window); window.requestAnimationFrame = (f) => { window.rafs.push((new Error().stack ?? '').split('\n').slice(2, 4).map((l) => l.trim().split(' ')[1]).join(' < ')); return r(f); }; window.timers = []; const st = window.setTimeout.bind(window); window.setTimeout = (f, ms, ...a) => { window.timers.push((new Error().stack ?? '').split('\n').slice(2, 3).map((l) => l.trim().split(' ')[1]).join('') + ' ' + ms); return st(f, ms, ...a); }; const si = window.setInterval.bind(window); window.setInterval = (f, ms, ...a) => { window.timers.push('interval ' + (new Error().stack ?? '').split('\n').slice(2, 3).join('') + ' ' + ms); return si(f, ms, ...a); }; });
+await page.goto(url);
+await page.waitForFunction(() => window.specdeformEditor?.ready, null, { timeout: 120000 });
+await page.waitForTimeout(2000);
+await page.evaluate(() => { window.rafs = []; window.timers = []; }); let a = cpu(); await page.waitForTimeout(5000); console.log(await page.evaluate(() => JSON.stringify([window.rafs.length, [...new Set(window.rafs)], window.timers.length, [...new Set(window.timers)].slice(0, 10)]))); console.log('idle 5 s', JSON.stringify(diff(a, cpu())));
+a = cpu(); await page.evaluate(() => new Promise((done) => { let i = 0; const t = setInterval(() => { document.getElementById('status').textContent = 'stage ' + (i++); if (i > 50) { clearInterval(t); done(); } }, 100); })); console.log('status 10/s 5 s', JSON.stringify(diff(a, cpu())));
+a = cpu(); await page.evaluate(() => new Promise((done) => { let i = 0; const t = setInterval(() => { window.specdeformEditor.setView([1, 0.1 * (i % 5), 1]); if (++i > 10) { clearInterval(t); done(); } }, 500); })); console.log('10 full draws', JSON.stringify(diff(a, cpu())));
+await browser.close(); editor.server.kill();
