@@ -34,7 +34,7 @@ export class Viewer {
   private readonly wireframe: THREE.Mesh;
   private readonly coarseGeometry = new THREE.BufferGeometry();
   private readonly coarse: THREE.Mesh;
-  private readonly ring: THREE.LineLoop;
+  private brushRing: { point: THREE.Vector3; normal: THREE.Vector3; radius: number } | null = null;
   private readonly cursorMark: THREE.LineSegments;
   private readonly previewLabel: HTMLElement;
   private readonly axes: HTMLCanvasElement; // the axis widget
@@ -69,12 +69,6 @@ export class Viewer {
     );
     this.wireframe.visible = false;
     this.surface.frustumCulled = this.wireframe.frustumCulled = this.coarse.frustumCulled = false;
-    const circle = new THREE.BufferGeometry().setFromPoints(
-      Array.from({ length: 64 }, (_, i) => new THREE.Vector3(Math.cos((i * Math.PI) / 32), Math.sin((i * Math.PI) / 32), 0)),
-    );
-    this.ring = new THREE.LineLoop(circle, new THREE.LineBasicMaterial({ color: 0x1d2026, depthTest: false, transparent: true }));
-    this.ring.visible = false;
-    this.ring.renderOrder = 1;
     // The 3D cursor: a red and white ring with a cross, drawn over the surface.
     const mark: THREE.Vector3[] = [];
     for (let i = 0; i < 16; ++i) {
@@ -90,7 +84,7 @@ export class Viewer {
       new THREE.LineBasicMaterial({ vertexColors: true, depthTest: false, transparent: true }));
     this.cursorMark.visible = false;
     this.cursorMark.renderOrder = 2;
-    this.scene.add(this.surface, this.look.mesh, this.coarse, this.wireframe, this.pivot, this.ring, this.cursorMark);
+    this.scene.add(this.surface, this.look.mesh, this.coarse, this.wireframe, this.pivot, this.cursorMark);
     this.previewLabel = Object.assign(document.createElement('div'), {
       id: 'preview-label', textContent: 'preview; detail on release', hidden: true });
     this.axes = Object.assign(document.createElement('canvas'), { id: 'axes', width: 96, height: 96,
@@ -291,15 +285,28 @@ export class Viewer {
     this.requestRender();
   }
 
-  // The brush's circle, on the surface's tangent plane at `hit`; null hides it.
+  // The brush's circle, on the surface's tangent plane at `hit`; null hides it. Drawn over the
+  // view (#brush-ring), so that following the pointer redraws no mesh (0.6 s for 1.4M triangles
+  // without a GPU); again after each draw, for the camera may have moved.
   showBrush(hit: Hit | null, radius: number): void {
-    this.ring.visible = hit !== null;
-    if (hit) {
-      this.ring.position.copy(hit.point);
-      this.ring.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1), hit.normal);
-      this.ring.scale.setScalar(radius);
-    }
-    this.requestRender();
+    this.brushRing = hit && { point: hit.point.clone(), normal: hit.normal.clone(), radius };
+    this.drawBrush();
+  }
+
+  private drawBrush(): void {
+    const svg = document.getElementById('brush-ring')!;
+    const b = this.brushRing;
+    svg.style.display = b ? 'block' : 'none';
+    if (!b) return;
+    const turn = new THREE.Quaternion().setFromUnitVectors(new THREE.Vector3(0, 0, 1), b.normal);
+    const [u, v] = [new THREE.Vector3(1, 0, 0).applyQuaternion(turn), new THREE.Vector3(0, 1, 0).applyQuaternion(turn)];
+    const at = svg.getBoundingClientRect();
+    const points = Array.from({ length: 48 }, (_, i) => {
+      const a = (i * Math.PI) / 24;
+      const s = this.toScreen(b.point.clone().addScaledVector(u, b.radius * Math.cos(a)).addScaledVector(v, b.radius * Math.sin(a)));
+      return `${(s.x - at.left).toFixed(1)},${(s.y - at.top).toFixed(1)}`;
+    });
+    svg.firstElementChild!.setAttribute('points', points.join(' '));
   }
 
   // The 3D cursor's mark at `point` (sized with the view), or none.
@@ -449,6 +456,7 @@ export class Viewer {
         void this.timeSubmitted().then((ms) => ([this.drawMs, this.timingDraw] = [ms, false]));
       }
       this.drawAxes();
+      this.drawBrush();
       this.onRendered();
     });
     const slow = this.drawMs > kSlowDrawMs && !this.coarse.visible; // the preview draws fast
