@@ -14,7 +14,9 @@ export type Tool = 'handle' | 'fixed' | 'erase' | 'move' | 'pin';
 // 3D cursor, or (G, R, S only) every movable group about its own centroid.
 export type PivotMode = 'median' | 'cursor' | 'individual';
 
-// How long the pointer rests before the full detail is asked for in place of the preview (ms).
+// How long the pointer rests before the full detail is asked for in place of the preview (ms):
+// this, or twice the full mesh's draw when that is longer (a draw that holds the next moves back
+// is not asked for between them).
 const kRestMs = 200;
 
 interface Drag {
@@ -29,9 +31,10 @@ interface Drag {
 export class Interaction {
   tool: Tool = 'handle';
   onToolChange: () => void = () => {};
-  private stroke: { before: Int16Array; touched: Set<number>; label: number; pin: number | null } | null = null;
+  // The stroke being painted; one ended while its last brush query was out is `finishing`
+  // (sent when the query is in) and no longer this.
+  private stroke: Stroke | null = null;
   private brushing = false; // a brush query in flight
-  private nextBrush: { x: number; y: number } | null = null;
   private drag: Drag | null = null;
   private restTimer: number | undefined;
   private usedPreview = false;
@@ -228,61 +231,74 @@ export class Interaction {
 
   // ------------------------------------------------------------ painting
 
-  private paintAt(x: number, y: number): void {
+  // One brush query is out at a time; the latest point of each stroke waits for it.
+  private paintAt(x: number, y: number, stroke: Stroke | null = this.stroke): void {
     if (this.brushing) {
-      this.nextBrush = { x, y };
+      if (stroke) this.waiting = [...this.waiting.filter((w) => w.stroke !== stroke), { x, y, stroke }];
       return;
     }
     const hit = this.s.viewer.pick(x, y);
     this.s.viewer.showBrush(hit, this.radius);
-    if (!hit || !this.stroke) return;
+    if (!stroke) return;
+    if (!hit) return this.brushDone(stroke);
     this.brushing = true;
     this.s.brush(hit.vertex, hit.point, this.radius, this.geodesic).then((vertices) => {
       this.brushing = false;
-      const stroke = this.stroke;
-      if (stroke) {
-        const labels = this.s.labels;
-        const changed: number[] = [];
-        const paired = this.xMirror.on && stroke.pin === null ? this.xMirror.paired(this.s, vertices, stroke.label) : [];
-        for (const [v, label] of [...Array.from(vertices, (v) => [v, stroke.label]), ...paired]) {
-          // A pin stroke claims free, fixed and handle vertices; other tools leave pins alone
-          // except Erase.
-          const l = labels[v];
-          const isPin = l >= 2 && this.s.groups[l - 2]?.pinned;
-          if (isPin && label !== FREE && l !== label) continue;
-          if (l !== label) {
-            labels[v] = label;
-            changed.push(v);
-            stroke.touched.add(v);
-          }
+      // Painted into the stroke that asked, which may have ended and another begun meanwhile.
+      const labels = this.s.labels;
+      const changed: number[] = [];
+      const paired = this.xMirror.on && stroke.pin === null ? this.xMirror.paired(this.s, vertices, stroke.label) : [];
+      for (const [v, label] of stroke.cancelled ? [] : [...Array.from(vertices, (v) => [v, stroke.label]), ...paired]) {
+        // A pin stroke claims free, fixed and handle vertices; other tools leave pins alone
+        // except Erase.
+        const l = labels[v];
+        const isPin = l >= 2 && this.s.groups[l - 2]?.pinned;
+        if (isPin && label !== FREE && l !== label) continue;
+        if (l !== label) {
+          labels[v] = label;
+          changed.push(v);
+          stroke.touched.add(v);
         }
-        this.s.paint(changed);
       }
-      const next = this.nextBrush;
-      this.nextBrush = null;
-      if (next && this.stroke) this.paintAt(next.x, next.y);
-      else if (this.finishPending) this.endStroke(true);
+      this.s.paint(changed);
+      this.brushDone(stroke);
     });
   }
-  private finishPending = false;
+  private waiting: { x: number; y: number; stroke: Stroke }[] = [];
 
-  // `keep`: send the stroke to the server (an undo step); otherwise restore what it painted.
+  // A brush query of `stroke` is in: the stroke is sent if it ended and has none waiting, and
+  // the next waiting point is painted.
+  private brushDone(stroke: Stroke): void {
+    if (stroke.finishing && !this.waiting.some((w) => w.stroke === stroke)) this.finishStroke(stroke);
+    const next = this.waiting.shift();
+    if (next) this.paintAt(next.x, next.y, next.stroke);
+  }
+
+  // `keep`: send the stroke to the server (an undo step), once its brush queries are in;
+  // otherwise restore what it painted.
   private endStroke(keep: boolean): void {
     const stroke = this.stroke;
     if (!stroke) return;
-    if (this.brushing && keep) {
-      this.finishPending = true; // the last brush query first
+    this.stroke = null;
+    if (keep && this.brushing) {
+      stroke.finishing = true;
       return;
     }
-    this.finishPending = false;
-    this.stroke = null;
-    this.s.painting = false;
-    if (!keep || stroke.touched.size === 0) {
-      this.s.labels.set(stroke.before);
-      this.s.paint([...stroke.touched]);
+    if (keep) return this.finishStroke(stroke);
+    stroke.cancelled = true;
+    this.waiting = this.waiting.filter((w) => w.stroke !== stroke);
+    for (const v of stroke.touched) this.s.labels[v] = stroke.before[v];
+    this.s.paint([...stroke.touched]);
+    if (stroke.pin !== null) this.dropEmptyGroup(stroke.pin);
+    this.s.painting = this.waiting.length > 0 || this.brushing;
+    this.s.changed();
+  }
+
+  private finishStroke(stroke: Stroke): void {
+    this.s.painting = this.stroke !== null || this.waiting.length > 0;
+    if (stroke.touched.size === 0) {
       if (stroke.pin !== null) this.dropEmptyGroup(stroke.pin);
-      this.s.changed();
-      return;
+      return this.s.changed();
     }
     this.s.sendSelection(stroke.pin !== null ? new Set([stroke.pin]) : new Set());
     if (stroke.label >= 2 && stroke.pin === null && this.oneSided(stroke.label)) {
@@ -353,7 +369,8 @@ export class Interaction {
     this.s.sendFrame(preview);
     clearTimeout(this.restTimer);
     // The pointer rests: the full detail, the preview again on the next move.
-    if (preview) this.restTimer = window.setTimeout(() => this.s.sendFrame(false), kRestMs);
+    const rest = Math.max(kRestMs, 2 * this.s.viewer.drawMs);
+    if (preview) this.restTimer = window.setTimeout(() => this.s.sendFrame(false), rest);
   }
 
   private beginGizmo(): void {
@@ -689,4 +706,13 @@ export class Interaction {
     if (points.length === 0) pick((l) => l !== FREE);
     this.s.viewer.frame(points);
   }
+}
+
+interface Stroke {
+  before: Int16Array; // the labels when it began
+  touched: Set<number>;
+  label: number;
+  pin: number | null; // the pinned group it paints, if a Pin stroke
+  finishing?: boolean; // ended while a brush query was out
+  cancelled?: boolean;
 }

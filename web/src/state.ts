@@ -614,17 +614,23 @@ export class EditorState {
     const colors = this.colorBuffer.length === 3 * n ? this.colorBuffer : (this.colorBuffer = new Float32Array(3 * n));
     const held = this.heldByInfluence();
     if (held) vertices = undefined;
+    let changed = false;
     const set = (v: number) => {
       const l = this.labels[v];
       const c = l === FREE ? (held?.[v] ? HELD_COLOR : FREE_COLOR) : l === FIXED ? FIXED_COLOR
         : this.groups[l - 2]?.pinned ? PIN_COLOR : GROUP_COLORS[(l - 2) % GROUP_COLORS.length];
-      colors[3 * v] = c.r;
-      colors[3 * v + 1] = c.g;
-      colors[3 * v + 2] = c.b;
+      const r = Math.fround(c.r), g = Math.fround(c.g), b = Math.fround(c.b);
+      if (colors[3 * v] === r && colors[3 * v + 1] === g && colors[3 * v + 2] === b) return;
+      colors[3 * v] = r;
+      colors[3 * v + 1] = g;
+      colors[3 * v + 2] = b;
+      changed = true;
     };
     if (vertices) for (let i = 0; i < vertices.length; ++i) set(vertices[i]);
     else for (let v = 0; v < n; ++v) set(v);
-    this.viewer.setColors(colors, vertices);
+    // The same colours again (the selection as the server confirms it) redraw nothing: a draw
+    // of a million triangles costs a second of CPU without a GPU.
+    if (changed) this.viewer.setColors(colors, vertices);
   }
   private colorBuffer = new Float32Array(0);
 }
