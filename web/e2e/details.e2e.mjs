@@ -4,7 +4,9 @@
 //  - a handle painted on the bar's side facing the camera is said to cover one side only;
 //  - during R the pivot's mark and a dashed line to the pointer are drawn, gone when confirmed;
 //    with a region of influence, its circle is drawn during G;
-//  - the X-mirror switch and pairing survive a reload: the mirrored group still moves mirrored.
+//  - the X-mirror switch and pairing survive a reload: the mirrored group still moves mirrored;
+//  - a stroke begun while the last one's brush query is out (as at a million vertices) leaves
+//    each its own label.
 //
 //   node e2e/details.e2e.mjs [--out DIR]
 import { mkdirSync } from 'node:fs';
@@ -125,6 +127,40 @@ try {
   await waitReady();
   const [t0, t1] = await api(() => window.specdeformEditor.transforms());
   check(t0[3] === 1 && t1[3] === -1, `after the reload the mirrored group moves mirrored (${t0[3]}, ${t1[3]})`);
+
+  log('a stroke begun while the last one is still being painted');
+  await page.uncheck('#x-mirror');
+  await page.click('#clear');
+  await waitReady();
+  await api(() => document.activeElement?.blur());
+  await dismiss();
+  // The other end of the bar from the side's vertex, facing the camera, on screen.
+  const end = await api((v) => {
+    const e = window.specdeformEditor;
+    const p = e.restPositions();
+    const cam = e.cameraPosition();
+    const near = (u) => Math.hypot(p[3 * u] - cam[0], p[3 * u + 1] - cam[1], p[3 * u + 2] - cam[2]);
+    let best = -1, far = 0;
+    for (let u = 0; u < p.length / 3; ++u) {
+      const s = e.vertexOnScreen(u);
+      const d = Math.hypot(p[3 * u] - p[3 * v], p[3 * u + 1] - p[3 * v + 1], p[3 * u + 2] - p[3 * v + 2]);
+      if (s.x > 60 && s.x < 1220 && near(u) < near(v) * 1.05 && d > far) [best, far] = [u, d];
+    }
+    return e.vertexOnScreen(best);
+  }, side);
+  await api(() => window.specdeformEditor.slowBrush(800)); // each brush query answered 0.8 s late
+  await page.click('[data-tool="handle"]');
+  await page.mouse.move(at.x, at.y);
+  await page.mouse.down();
+  await page.mouse.up();
+  await page.keyboard.press('2'); // Fixed, while the handle's query is out
+  await page.mouse.move(end.x, end.y);
+  await page.mouse.down();
+  await page.mouse.up();
+  await waitReady();
+  await api(() => window.specdeformEditor.slowBrush(0));
+  const both = await api(() => window.specdeformEditor.counts());
+  check(both.handles > 0 && both.fixed > 0, `each stroke kept its own label (${JSON.stringify(both)})`);
   check(pageErrors.length === 0, `no page errors: ${pageErrors.join('; ')}`);
 } catch (e) {
   for (const page of browser.contexts().flatMap((c) => c.pages())) {

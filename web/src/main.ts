@@ -42,6 +42,7 @@ const viewer = state.viewer;
   positions: () => Array.from(viewer.positions()),
   labels: () => Array.from(state.labels),
   counts: () => state.counts(), // of the labels painted
+  slowBrush: (ms: number) => (state.brushDelayMs = ms),
   transforms: () => state.groups.map((g) => rowMajor(g.transform)),
   vertexOnScreen: (v: number) => viewer.toScreen(new THREE.Vector3().fromArray(viewer.positions(), 3 * v)),
   diagonal: () => state.diagonal,

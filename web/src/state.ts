@@ -240,8 +240,10 @@ export class EditorState {
     const id = ++this.brushId;
     const request: WorkerRequest = { kind: 'brush', id, vertex, center: [center.x, center.y, center.z], radius, geodesic };
     this.worker.postMessage(request);
-    return new Promise((resolve) => this.brushReplies.set(id, resolve));
+    const delay = this.brushDelayMs;
+    return new Promise((resolve) => this.brushReplies.set(id, (v) => setTimeout(() => resolve(v), delay)));
   }
+  brushDelayMs = 0; // automation: the worker's replies held back this long (a large mesh's pace)
 
   // ------------------------------------------------------------ incoming
 
