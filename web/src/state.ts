@@ -50,7 +50,7 @@ const kPreviewMs = 8;
 // A mesh's first draw slower than this is slow whatever its upload took (25 MB at a million
 // vertices: a few milliseconds on a GPU).
 const kUploadMs = 100;
-const kProgressMs = 500;
+const kProgressMs = 500; // a stage's progress shown this often at most
 
 export class EditorState {
   phase: Phase = { kind: 'connecting' };
@@ -106,6 +106,7 @@ export class EditorState {
     };
     this.worker.onmessage = (e: MessageEvent<WorkerReply>) => this.onWorker(e.data);
     viewer.onRendered = () => this.onRendered();
+    viewer.onDrawTimed = (ms, draw) => this.drawTimed(ms, draw);
   }
 
   private progressShown = -Infinity; // when the page last showed a change (changed())
@@ -241,7 +242,7 @@ export class EditorState {
     const request: WorkerRequest = { kind: 'brush', id, vertex, center: [center.x, center.y, center.z], radius, geodesic };
     this.worker.postMessage(request);
     const delay = this.brushDelayMs;
-    return new Promise((resolve) => this.brushReplies.set(id, (v) => setTimeout(() => resolve(v), delay)));
+    return new Promise((resolve) => this.brushReplies.set(id, delay ? (v) => setTimeout(() => resolve(v), delay) : resolve));
   }
   brushDelayMs = 0; // automation: the worker's replies held back this long (a large mesh's pace)
 
@@ -429,7 +430,7 @@ export class EditorState {
     if (this.firstDraw === 'shown') {
       this.firstDraw = 'drawn';
       stats.meshDrawn = performance.now();
-      void this.timeDraw();
+      this.previewFrom = this.viewer.draws;
     }
     if (this.pendingDraw === null) return;
     const t = this.sentAt.get(this.pendingDraw);
@@ -469,6 +470,7 @@ export class EditorState {
       this.preparing = true;
       this.selectionHeld = false;
       this.firstDraw = 'none';
+      this.previewFrom = null;
       this.paint();
     }
   }
@@ -486,14 +488,19 @@ export class EditorState {
     if (m.basis.warning) this.note(m.basis.warning, 'error');
   }
 
-  // Times the new mesh's first draw without waiting for it (the page keeps painting); if it is
-  // too slow for drags, asks for a preview that draws in about kPreviewMs. That draw included
-  // the upload: one between the budget and kUploadMs is timed again on the next draw.
-  private async timeDraw(): Promise<void> {
-    const mesh = this.indices;
-    let ms = await this.viewer.timeSubmitted();
-    if (ms > kFullDrawBudgetMs && ms < kUploadMs) ms = await this.viewer.timeNextDraw();
-    if (this.indices !== mesh) return; // another mesh came meanwhile
+  // A draw of the full mesh was timed (the viewer times them without waiting: the page keeps
+  // painting). The new mesh's first decides whether drags show a preview that draws in about
+  // kPreviewMs; it included the upload, so one between the budget and kUploadMs waits for the
+  // next draw's time.
+  private drawTimed(ms: number, draw: number): void {
+    if (this.previewFrom === null) return;
+    // An earlier draw's time: the viewer times one draw at a time, so the mesh's first was not.
+    if (draw < this.previewFrom) return this.viewer.requestRender();
+    if (draw === this.previewFrom && ms > kFullDrawBudgetMs && ms < kUploadMs) {
+      this.previewFrom = draw + 1;
+      return this.viewer.requestRender();
+    }
+    this.previewFrom = null;
     this.drawMs = ms;
     const n = this.rest.length / 3;
     const wanted = this.drawMs > kFullDrawBudgetMs;
@@ -503,6 +510,7 @@ export class EditorState {
     if (!this.preparing) this.sendPreviewRequest();
     this.changed();
   }
+  private previewFrom: number | null = null; // the new mesh's first draw, while its preview is chosen
 
   // The server sets the preview's deformer up (seconds at a million vertices) after the
   // selection painted while the mesh was prepared, not before it.

@@ -27,6 +27,7 @@ export class Viewer {
   freeColor = new THREE.Color(); // the colour of vertices no selection holds (the file's own show)
   private lookShown = true;
   onRendered: () => void = () => {};
+  onDrawTimed: (ms: number, draw: number) => void = () => {}; // a full draw's time; `draw`: its number (draws)
 
   readonly scene = new THREE.Scene();
   private readonly geometry = new THREE.BufferGeometry();
@@ -413,7 +414,7 @@ export class Viewer {
   // Milliseconds until the GPU (or the software renderer's threads) has done what was submitted
   // so far, without waiting for it: a fence, polled every few milliseconds while the page goes on
   // taking events. Called right after a draw, it times that draw.
-  timeSubmitted(): Promise<number> {
+  private timeSubmitted(): Promise<number> {
     const gl = this.renderer.getContext() as WebGL2RenderingContext;
     const start = performance.now();
     const fence = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
@@ -429,15 +430,6 @@ export class Viewer {
     });
   }
 
-  // The next draw, timed (timeSubmitted).
-  timeNextDraw(): Promise<number> {
-    return new Promise((resolve) => {
-      this.afterDraw.push(() => void this.timeSubmitted().then(resolve));
-      this.requestRender();
-    });
-  }
-  private afterDraw: (() => void)[] = [];
-
   // Draws on the next animation frame. A slow draw (the full large mesh without a GPU) is
   // followed by as long without one, so that pointer events, which wait for the frame being drawn, still
   // come in at once half of the time.
@@ -449,11 +441,14 @@ export class Viewer {
       this.renderer.render(this.scene, this.camera);
       this.lastDraw = performance.now();
       ++this.draws;
-      for (const f of this.afterDraw.splice(0)) f();
       // The full mesh's draws, timed one at a time, pace the next.
       if (!this.coarse.visible && !this.timingDraw) {
         this.timingDraw = true;
-        void this.timeSubmitted().then((ms) => ([this.drawMs, this.timingDraw] = [ms, false]));
+        const draw = this.draws;
+        void this.timeSubmitted().then((ms) => {
+          [this.drawMs, this.timingDraw] = [ms, false];
+          this.onDrawTimed(ms, draw);
+        });
       }
       this.drawAxes();
       this.drawBrush();
