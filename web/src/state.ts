@@ -624,16 +624,26 @@ export class EditorState {
     const colors = this.colorBuffer.length === 3 * n ? this.colorBuffer : (this.colorBuffer = new Float32Array(3 * n));
     const held = this.heldByInfluence();
     if (held) vertices = undefined;
+    // Each label's colour as the buffer holds it (0 free, 1 fixed, 2 + g group g), then the
+    // held free vertices': no per-vertex object or rounding (the first paint covers 692k).
+    const labels = this.labels;
+    let top: number = FIXED;
+    for (let v = 0; v < n; ++v) if (labels[v] > top) top = labels[v];
+    const table = new Float32Array(3 * (top + 2));
+    for (let l = 0; l <= top; ++l) {
+      const c = l === FREE ? FREE_COLOR : l === FIXED ? FIXED_COLOR
+        : this.groups[l - 2]?.pinned ? PIN_COLOR : GROUP_COLORS[(l - 2) % GROUP_COLORS.length];
+      table.set([c.r, c.g, c.b], 3 * l);
+    }
+    const heldAt = 3 * (top + 1);
+    table.set([HELD_COLOR.r, HELD_COLOR.g, HELD_COLOR.b], heldAt);
     let changed = false;
     const set = (v: number) => {
-      const l = this.labels[v];
-      const c = l === FREE ? (held?.[v] ? HELD_COLOR : FREE_COLOR) : l === FIXED ? FIXED_COLOR
-        : this.groups[l - 2]?.pinned ? PIN_COLOR : GROUP_COLORS[(l - 2) % GROUP_COLORS.length];
-      const r = Math.fround(c.r), g = Math.fround(c.g), b = Math.fround(c.b);
-      if (colors[3 * v] === r && colors[3 * v + 1] === g && colors[3 * v + 2] === b) return;
-      colors[3 * v] = r;
-      colors[3 * v + 1] = g;
-      colors[3 * v + 2] = b;
+      const k = labels[v] === FREE && held?.[v] ? heldAt : 3 * labels[v];
+      if (colors[3 * v] === table[k] && colors[3 * v + 1] === table[k + 1] && colors[3 * v + 2] === table[k + 2]) return;
+      colors[3 * v] = table[k];
+      colors[3 * v + 1] = table[k + 1];
+      colors[3 * v + 2] = table[k + 2];
       changed = true;
     };
     if (vertices) for (let i = 0; i < vertices.length; ++i) set(vertices[i]);
