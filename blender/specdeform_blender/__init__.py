@@ -56,7 +56,7 @@ def unregister():
     atexit.unregister(binding.shutdown)
     for handler_list, handler in _handlers:
         handler_list.remove(handler)
-    binding.forget_all()
+    binding.shutdown()
     del bpy.types.Object.specdeform
     for cls in reversed(classes):
         bpy.utils.unregister_class(cls)

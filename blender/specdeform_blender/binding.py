@@ -54,8 +54,12 @@ def forget_all():
 
 
 def shutdown():
-    """At exit (atexit): the cache files being saved written, and the deformers, with their
-    background threads, released while Python and the library are still whole."""
+    """At exit (atexit) and when the add-on is disabled (Blender disables every add-on as it
+    quits, before Python's atexit): the cache files being saved written, the bases being computed
+    cancelled, and the deformers, with their background threads, released while Python and the
+    library are still whole. A worker thread still inside the library when Python finalises is
+    ended mid-call, which aborts Blender ("terminate called without an active exception", seen
+    after a test's Bind whose basis was still being saved)."""
     for job in list(_jobs):
         job.cancel()
         job._thread.join()
