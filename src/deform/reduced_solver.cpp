@@ -45,6 +45,9 @@ void ReducedSolver::set_constraints(const std::vector<int>& vertices) {
   const bool rebuild = column_of_.empty() || 2 * (added.size() + removed.size()) > vertices.size();
   column_of_ = std::move(column_of);
   columns_ = std::move(columns);
+  vertex_ = vertices;
+  moments_.clear();
+  group_.clear();
   weights_.resize(nc);
   for (int i = 0; i < nc; ++i) weights_[i] = weight(vertices[i]);
   if (options_.constraints == ConstraintMode::Soft) {
@@ -124,6 +127,71 @@ ReducedSolver::Targets ReducedSolver::prepare(const Eigen::MatrixX3d& targets) c
       out.rhs.noalias() += columns_.col(i) * (weights_[i] * targets.row(i));
       out.constant += weights_[i] * targets.row(i).squaredNorm();
     }
+  }
+  return out;
+}
+
+void ReducedSolver::set_groups(const std::vector<int>& group, int num_groups,
+                               const Eigen::MatrixX3d& positions) {
+  const Eigen::Index nc = columns_.cols(), m = columns_.rows();
+  if (static_cast<Eigen::Index>(group.size()) != nc) {
+    throw InputError("deformation: groups for " + std::to_string(group.size()) +
+                     " vertices, the selection has " + std::to_string(nc));
+  }
+  group_ = group;
+  rest_.resize(nc, 3);
+  for (Eigen::Index i = 0; i < nc; ++i) rest_.row(i) = positions.row(vertex_[i]);
+  moments_.assign(num_groups, Moments{});
+  for (Moments& g : moments_) {
+    g.h0 = Eigen::VectorXd::Zero(m);
+    g.h1 = Eigen::MatrixX3d::Zero(m, 3);
+  }
+  for (Eigen::Index i = 0; i < nc; ++i) {
+    if (group[i] < 0) continue;
+    Moments& g = moments_.at(group[i]);
+    g.weight += weights_[i];
+    g.centroid += weights_[i] * rest_.row(i).transpose();
+  }
+  for (Moments& g : moments_)
+    if (g.weight > 0.0) g.centroid /= g.weight;
+  for (Eigen::Index i = 0; i < nc; ++i) {
+    if (group[i] < 0) continue;
+    Moments& g = moments_[group[i]];
+    const Eigen::Vector3d r = rest_.row(i).transpose() - g.centroid;
+    g.spread += weights_[i] * r * r.transpose();
+    g.h0 += weights_[i] * columns_.col(i);
+    g.h1.noalias() += columns_.col(i) * (weights_[i] * r.transpose());
+  }
+}
+
+ReducedSolver::Targets ReducedSolver::prepare(
+    const std::vector<Eigen::Affine3d>& transforms) const {
+  if (group_.size() != static_cast<size_t>(columns_.cols())) {
+    throw InputError("deformation: the handle groups of the selection are not set");
+  }
+  if (transforms.size() != moments_.size()) {
+    throw InputError("deformation: " + std::to_string(transforms.size()) + " transforms for " +
+                     std::to_string(moments_.size()) + " handle groups");
+  }
+  if (options_.constraints == ConstraintMode::Hard) {  // n' <= m: per vertex
+    Eigen::MatrixX3d targets = Eigen::MatrixX3d::Zero(rest_.rows(), 3);
+    for (Eigen::Index i = 0; i < rest_.rows(); ++i) {
+      if (group_[i] >= 0) {
+        const Eigen::Vector3d s = rest_.row(i).transpose();
+        targets.row(i) = (transforms[group_[i]] * s - s).transpose();
+      }
+    }
+    return prepare(targets);
+  }
+  Targets out;
+  out.rhs = Eigen::MatrixX3d::Zero(columns_.rows(), 3);
+  for (size_t k = 0; k < moments_.size(); ++k) {
+    const Moments& g = moments_[k];
+    const Eigen::Matrix3d B = transforms[k].linear() - Eigen::Matrix3d::Identity();
+    const Eigen::Vector3d u = transforms[k] * g.centroid - g.centroid;
+    out.rhs.noalias() += g.h1 * B.transpose();
+    out.rhs.noalias() += g.h0 * u.transpose();
+    out.constant += (B * g.spread * B.transpose()).trace() + g.weight * u.squaredNorm();
   }
   return out;
 }
