@@ -125,7 +125,8 @@ void SpectralDeformer::build_solvers(std::shared_ptr<const ManifoldHarmonics> ba
         solve_basis_,
         arap_ ? arap_->reduced_hessian() : linear_hessian(mesh_, *solve_basis_, options_),
         piece_area_fractions(lumped_mass(mesh_), components_, num_components_), options_);
-    if (options_.float32_basis) basis32_ = solve_basis_->basis.cast<float>();
+    factored_ = solve_basis_->factored.smaller_than_dense(options_.float32_basis ? 4 : 8);
+    if (options_.float32_basis && !factored_) basis32_ = solve_basis_->basis.cast<float>();
   } else {
     spatial_ = std::make_unique<SpatialSolver>(mesh_, options_);
   }
@@ -168,6 +169,7 @@ void SpectralDeformer::set_selection(const Selection& selection) {
   }
   if (reduced_) {
     reduced_->set_constraints(constrained_.vertices);
+    reduced_->set_groups(constrained_.group, constrained_.num_groups, base_);
   } else {
     clock.lap();
     spatial_->set_constraints(constrained_.vertices);
@@ -193,9 +195,6 @@ Eigen::MatrixX3d SpectralDeformer::solve_coefficients(
   }
   Clock clock;
   Eigen::MatrixX3d base_targets = constraint_targets(constrained_, base_, transforms);
-  Eigen::MatrixX3d displacement_targets = base_targets;
-  for (size_t i = 0; i < constrained_.vertices.size(); ++i)
-    displacement_targets.row(i) -= base_.row(constrained_.vertices[i]);
   // ARAP starts from the handles' rotations spread over the surface, or from the last frame
   // when asked to.
   const Eigen::Index size = reduced_ ? solve_basis_->basis.cols() : mesh_.num_vertices();
@@ -203,7 +202,7 @@ Eigen::MatrixX3d SpectralDeformer::solve_coefficients(
   arap_report_ = ArapReport{};
   arap_report_.converged = true;
   if (reduced_) {
-    const ReducedSolver::Targets targets = reduced_->prepare(displacement_targets);
+    const ReducedSolver::Targets targets = reduced_->prepare(transforms);
     if (arap_) {
       state_ = arap_->solve(
           *reduced_, targets,
@@ -213,6 +212,9 @@ Eigen::MatrixX3d SpectralDeformer::solve_coefficients(
       state_.x = reduced_->solve(targets, Eigen::MatrixX3d());
     }
   } else {
+    Eigen::MatrixX3d displacement_targets = base_targets;
+    for (size_t i = 0; i < constrained_.vertices.size(); ++i)
+      displacement_targets.row(i) -= base_.row(constrained_.vertices[i]);
     const SpatialSolver::Targets targets = spatial_->prepare(displacement_targets);
     if (arap_) {
       state_ = arap_->solve(
@@ -230,6 +232,8 @@ Eigen::MatrixX3d SpectralDeformer::solve_coefficients(
 void SpectralDeformer::inverse_transform(const Vertices& origin, Vertices& deformed) const {
   if (!reduced_) {
     deformed = origin + state_.x;
+  } else if (factored_) {
+    detail::add_basis_product(origin, solve_basis_->factored, state_.x, deformed);
   } else if (options_.float32_basis) {
     detail::add_basis_product(origin, basis32_, state_.x, deformed);
   } else {
@@ -277,7 +281,9 @@ void SpectralDeformer::preview(const std::vector<Eigen::Affine3d>& transforms,
   Clock total;
   solve_coefficients(transforms);
   Clock clock;
-  if (options_.float32_basis) {
+  if (factored_) {
+    detail::add_basis_product(mesh_.V, solve_basis_->factored, state_.x, out);
+  } else if (options_.float32_basis) {
     detail::add_basis_product(mesh_.V, basis32_, state_.x, out);
   } else {
     detail::add_basis_product(mesh_.V, solve_basis_->basis, state_.x, out);

@@ -94,6 +94,34 @@ void add_product(const Eigen::MatrixX3d& base, const Matrix& H, const Eigen::Mat
   });
 }
 
+template <typename Store>
+void add_factored_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
+                          const Eigen::MatrixX3d& C, Store store) {
+  const auto& P = H.prolongation;
+  if (C.rows() != H.coarse.cols() || base.rows() != P.rows() || P.cols() != H.coarse.rows() ||
+      !P.isCompressed()) {
+    throw InputError("basis product: the sizes do not match");
+  }
+  const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> ZC = H.coarse * C;
+  const int* start = P.outerIndexPtr();
+  const int* column = P.innerIndexPtr();
+  const double* value = P.valuePtr();
+  const double* b = base.data();
+  const Eigen::Index n = P.rows();
+  split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index i = begin; i < end; ++i) {
+      double x = 0.0, y = 0.0, z = 0.0;
+      for (int k = start[i]; k < start[i + 1]; ++k) {
+        const double* row = ZC.data() + 3 * Eigen::Index{column[k]};
+        x += value[k] * row[0];
+        y += value[k] * row[1];
+        z += value[k] * row[2];
+      }
+      store(i, b[i] + x, b[n + i] + y, b[2 * n + i] + z);
+    }
+  });
+}
+
 }  // namespace
 
 void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXd& H,
@@ -118,6 +146,44 @@ void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXf& H,
                        const Eigen::MatrixX3d& C, Eigen::Ref<FloatVertices> out) {
   if (out.rows() != H.rows()) throw InputError("basis product: the sizes do not match");
   add_product(base, H, C, FloatRows{out.data(), out.outerStride()}, add_rows_float_to_floats);
+}
+
+void add_basis_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
+                       const Eigen::MatrixX3d& C, Eigen::MatrixX3d& out) {
+  out.resize(H.prolongation.rows(), 3);
+  add_factored_product(base, H, C, Doubles{out.data(), out.rows()});
+}
+
+void add_basis_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
+                       const Eigen::MatrixX3d& C, Eigen::Ref<FloatVertices> out) {
+  if (out.rows() != H.prolongation.rows()) {
+    throw InputError("basis product: the sizes do not match");
+  }
+  add_factored_product(base, H, C, FloatRows{out.data(), out.outerStride()});
+}
+
+Eigen::MatrixXd factored_product(const FactoredBasis& H) {
+  constexpr Eigen::Index kTile = 64;
+  using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const auto& P = H.prolongation;
+  const RowMat Z = H.coarse;
+  const Eigen::Index m = Z.cols();
+  Eigen::MatrixXd out(P.rows(), m);
+  split_in_two(P.rows(), [&](Eigen::Index begin, Eigen::Index end) {
+    RowMat tile(kTile, m);
+    for (Eigen::Index first = begin; first < end; first += kTile) {
+      const Eigen::Index rows = std::min(kTile, end - first);
+      tile.setZero();
+      for (Eigen::Index r = 0; r < rows; ++r) {
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P, first + r); it;
+             ++it) {
+          tile.row(r) += it.value() * Z.row(it.index());
+        }
+      }
+      out.middleRows(first, rows) = tile.topRows(rows);
+    }
+  });
+  return out;
 }
 
 }  // namespace specdeform::detail

@@ -4,11 +4,14 @@
 // blocks are split between two threads. Plain loops rather than a BLAS call, which would pack
 // (copy) all of H first. The result into column-major doubles, or into rows of three floats
 // (the layout of a front end's vertex buffer, written in place).
+// A factored basis H = P Z (spectral/manifold_harmonics.h): base + P (Z C), Z C first (N x 3),
+// then each row of P gathers its dozen rows of it, on two threads.
 #pragma once
 
 #include <Eigen/Core>
 
 #include "specdeform/mesh/triangle_mesh.h"
+#include "specdeform/spectral/manifold_harmonics.h"
 
 namespace specdeform::detail {
 
@@ -22,5 +25,14 @@ void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXd& H,
                        const Eigen::MatrixX3d& C, Eigen::Ref<FloatVertices> out);
 void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXf& H,
                        const Eigen::MatrixX3d& C, Eigen::Ref<FloatVertices> out);
+
+void add_basis_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
+                       const Eigen::MatrixX3d& C, Eigen::MatrixX3d& out);
+void add_basis_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
+                       const Eigen::MatrixX3d& C, Eigen::Ref<FloatVertices> out);
+
+// H = P Z itself (n x m, column-major): each row gathered into a row-major tile of 64 rows,
+// stored into H's columns a tile at a time, on two threads.
+Eigen::MatrixXd factored_product(const FactoredBasis& H);
 
 }  // namespace specdeform::detail

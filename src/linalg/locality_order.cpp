@@ -76,4 +76,17 @@ void permute_rows_back(const Permutation& P, Eigen::MatrixXd& X) {
   });
 }
 
+void permute_rows_back(const Permutation& P, Eigen::SparseMatrix<double, Eigen::RowMajor>& X) {
+  const int* to = P.indices().data();
+  Eigen::SparseMatrix<double, Eigen::RowMajor> out(X.rows(), X.cols());
+  out.reserve(X.nonZeros());
+  for (Eigen::Index i = 0; i < X.rows(); ++i) {
+    out.startVec(i);
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(X, to[i]); it; ++it)
+      out.insertBack(i, it.index()) = it.value();
+  }
+  out.finalize();
+  X = std::move(out);
+}
+
 }  // namespace specdeform::detail

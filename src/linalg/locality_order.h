@@ -24,7 +24,9 @@ Permutation breadth_first_order(int n, const int* start, const int* neighbour);
 Eigen::SparseMatrix<double> renumbered(const Eigen::SparseMatrix<double>& A, const Permutation& P);
 
 // X.row(i) = X.row(P.indices()[i]) for every i, column by column with one column of scratch
-// per thread (P.transpose() * X would need a second n x m matrix); two threads.
+// per thread (P.transpose() * X would need a second n x m matrix); two threads. A sparse X is
+// rebuilt row by row.
 void permute_rows_back(const Permutation& P, Eigen::MatrixXd& X);
+void permute_rows_back(const Permutation& P, Eigen::SparseMatrix<double, Eigen::RowMajor>& X);
 
 }  // namespace specdeform::detail

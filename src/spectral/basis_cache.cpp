@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "linalg/basis_product.h"
 #include "specdeform/atomic_file.h"
 #include "specdeform/exceptions.h"
 
@@ -16,9 +17,10 @@ namespace specdeform {
 namespace {
 
 constexpr char kMagic[8] = {'S', 'D', 'B', 'A', 'S', 'I', 'S', '\0'};
-constexpr uint32_t kVersion = 5;  // 1: no Laplacian byte (cotan); 1 and 2: no solver report;
+constexpr uint32_t kVersion = 6;  // 1: no Laplacian byte (cotan); 1 and 2: no solver report;
                                   // 1 to 3: exact bases only, no residuals per pair; 1 to 4:
-                                  // no pieces and requested modes
+                                  // no pieces and requested modes; 1 to 5: no factored bases
+constexpr uint8_t kFactored = 0;  // the scalar byte of a factored basis
 constexpr size_t kHeaderSize = 8 + 4 + 4 + 4 + 1 + 1 + 1 + 1 + 8;
 constexpr size_t kReportSize = 4 * 8 + 4 + 4 + 8 + 8;
 
@@ -35,6 +37,42 @@ T get(const char*& p) {
   std::memcpy(&v, p, sizeof(T));
   p += sizeof(T);
   return v;
+}
+
+// The factors P (n x N) and Z (N x m) of a factored basis: false where the file ends early;
+// throws on indices that do not make a matrix of these sizes.
+bool read_factors(std::ifstream& file, const std::string& name, uint32_t n, uint32_t m,
+                  FactoredBasis& f) {
+  uint32_t N;
+  uint64_t nonzeros;
+  if (!file.read(reinterpret_cast<char*>(&N), 4) ||
+      !file.read(reinterpret_cast<char*>(&nonzeros), 8)) {
+    return false;
+  }
+  if (N == 0 || N > n || nonzeros > uint64_t{std::numeric_limits<int>::max()}) {
+    throw InputError(name + ": corrupt basis factors");
+  }
+  const std::streamoff here = file.tellg();  // nothing allocated beyond what the file holds
+  file.seekg(0, std::ios::end);
+  const auto left = static_cast<uint64_t>(file.tellg() - here);
+  file.seekg(here);
+  if (4 * (uint64_t{n} + 1) + 12 * nonzeros + 8 * uint64_t{N} * m > left) return false;
+  const auto nnz = static_cast<Eigen::Index>(nonzeros);
+  auto& P = f.prolongation;
+  P.resize(n, N);
+  P.resizeNonZeros(nnz);
+  bool ok = file.read(reinterpret_cast<char*>(P.outerIndexPtr()), 4 * (size_t(n) + 1)) &&
+            file.read(reinterpret_cast<char*>(P.innerIndexPtr()), 4 * size_t(nnz)) &&
+            file.read(reinterpret_cast<char*>(P.valuePtr()), 8 * size_t(nnz));
+  if (!ok) return false;
+  const int* start = P.outerIndexPtr();
+  const int* column = P.innerIndexPtr();
+  bool valid = start[0] == 0 && start[n] == nnz;
+  for (uint32_t i = 0; valid && i < n; ++i) valid = start[i] <= start[i + 1];
+  for (Eigen::Index k = 0; valid && k < nnz; ++k) valid = column[k] >= 0 && uint32_t(column[k]) < N;
+  if (!valid) throw InputError(name + ": corrupt basis factors");
+  f.coarse.resize(N, m);
+  return static_cast<bool>(file.read(reinterpret_cast<char*>(f.coarse.data()), 8 * size_t(N) * m));
 }
 
 }  // namespace
@@ -61,14 +99,23 @@ void save_basis(const std::filesystem::path& path, const ManifoldHarmonics& basi
     throw InputError(path.string() + ": the basis does not match the mesh it is saved with");
   }
   const bool single = precision == BasisPrecision::Float32;
+  const bool factored = basis.factored.smaller_than_dense(single ? 4 : 8);
+  if (factored && (basis.factored.prolongation.rows() != n || basis.factored.coarse.cols() != m ||
+                   !basis.factored.prolongation.isCompressed())) {
+    throw InputError(path.string() + ": the basis's factors do not match the basis");
+  }
+  const size_t body = factored ? 12 + 4 * (size_t(n) + 1) +
+                                     12 * size_t(basis.factored.prolongation.nonZeros()) +
+                                     8 * size_t(basis.factored.coarse.size())
+                               : (single ? 4 : 8) * size_t(n) * m;
   std::string out;
-  out.reserve(kHeaderSize + kReportSize + 8 + 16 * size_t(m) + (single ? 4 : 8) * size_t(n) * m);
+  out.reserve(kHeaderSize + kReportSize + 8 + 16 * size_t(m) + body);
   out.append(kMagic, 8);
   put(out, kVersion);
   put(out, n);
   put(out, m);
   put(out, static_cast<uint8_t>(basis.mass == MassType::Lumped ? 0 : 1));
-  put(out, static_cast<uint8_t>(single ? 4 : 8));
+  put(out, factored ? kFactored : static_cast<uint8_t>(single ? 4 : 8));
   put(out, static_cast<uint8_t>(basis.laplacian == LaplacianType::Cotan ? 0 : 1));
   put(out, uint8_t{0});
   put(out, mesh_hash(mesh));
@@ -91,7 +138,16 @@ void save_basis(const std::filesystem::path& path, const ManifoldHarmonics& basi
                                         ? basis.residuals
                                         : Eigen::VectorXd::Constant(m, basis.max_residual);
   out.append(reinterpret_cast<const char*>(residuals.data()), 8 * size_t(m));
-  if (single) {
+  if (factored) {
+    const auto& P = basis.factored.prolongation;
+    const Eigen::MatrixXd& Z = basis.factored.coarse;
+    put(out, static_cast<uint32_t>(Z.rows()));
+    put(out, static_cast<uint64_t>(P.nonZeros()));
+    out.append(reinterpret_cast<const char*>(P.outerIndexPtr()), 4 * (size_t(n) + 1));
+    out.append(reinterpret_cast<const char*>(P.innerIndexPtr()), 4 * size_t(P.nonZeros()));
+    out.append(reinterpret_cast<const char*>(P.valuePtr()), 8 * size_t(P.nonZeros()));
+    out.append(reinterpret_cast<const char*>(Z.data()), 8 * size_t(Z.size()));
+  } else if (single) {
     const Eigen::MatrixXf H = basis.basis.cast<float>();
     out.append(reinterpret_cast<const char*>(H.data()), 4 * size_t(n) * m);
   } else {
@@ -125,7 +181,8 @@ ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMe
     throw InputError(name + ": the basis belongs to another mesh (" + std::to_string(n) +
                      " vertices, different geometry or faces); recompute it");
   }
-  if (mass > 1 || (scalar != 4 && scalar != 8) || laplacian > 1 || m == 0 || m > n) {
+  const bool factored = version >= 6 && scalar == kFactored;
+  if (mass > 1 || (scalar != 4 && scalar != 8 && !factored) || laplacian > 1 || m == 0 || m > n) {
     throw InputError(name + ": corrupt basis header");
   }
   ManifoldHarmonics out;
@@ -163,14 +220,17 @@ ManifoldHarmonics load_basis(const std::filesystem::path& path, const TriangleMe
   out.mass = mass == 0 ? MassType::Lumped : MassType::Consistent;
   out.laplacian = laplacian == 0 ? LaplacianType::Cotan : LaplacianType::IntrinsicDelaunay;
   out.eigenvalues.resize(m);
-  out.basis.resize(n, m);
+  if (!factored) out.basis.resize(n, m);
   bool ok =
       static_cast<bool>(file.read(reinterpret_cast<char*>(out.eigenvalues.data()), 8 * size_t(m)));
   out.residuals = Eigen::VectorXd::Constant(m, out.max_residual);
   if (ok && version >= 4) {
     ok = static_cast<bool>(file.read(reinterpret_cast<char*>(out.residuals.data()), 8 * size_t(m)));
   }
-  if (ok && scalar == 8) {
+  if (ok && factored) {
+    ok = read_factors(file, name, n, m, out.factored);
+    if (ok) out.basis = detail::factored_product(out.factored);
+  } else if (ok && scalar == 8) {
     ok = static_cast<bool>(file.read(reinterpret_cast<char*>(out.basis.data()), 8 * size_t(n) * m));
   } else if (ok) {  // through a small buffer: no float copy of the whole basis
     std::vector<float> chunk(size_t{1} << 18);

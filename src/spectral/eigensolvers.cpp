@@ -78,7 +78,9 @@ void report(const ManifoldHarmonicsOptions& o, double fraction, std::string_view
 Spectrum solve_dense(const Sparse& K, const Sparse& M, int m) {
   Eigen::GeneralizedSelfAdjointEigenSolver<Mat> eig{Mat(K), Mat(M)};
   if (eig.info() != Eigen::Success) throw SolverError("dense generalized eigensolver failed");
-  Spectrum out{eig.eigenvalues().head(m), eig.eigenvectors().leftCols(m)};
+  Spectrum out;
+  out.lambda = eig.eigenvalues().head(m);
+  out.H = eig.eigenvectors().leftCols(m);
   // K's null space (one constant per connected component) has the eigenvalue 0 exactly, not
   // the solver's +-1e-16.
   const Eigen::Index zeros = std::min<Eigen::Index>(m, stiffness_null_space(K, M).cols());
@@ -100,7 +102,9 @@ Spectrum solve_lanczos(const Sparse& K, const Sparse& M, const ManifoldHarmonics
   report(o, 0.1, "Lanczos");
   eigs.compute(Spectra::SortRule::LargestMagn, 10 * o.max_restarts, o.tolerance,
                Spectra::SortRule::SmallestAlge);
-  Spectrum out{eigs.eigenvalues(), eigs.eigenvectors()};
+  Spectrum out;
+  out.lambda = eigs.eigenvalues();
+  out.H = eigs.eigenvectors();
   out.status = eigs.info() == Spectra::CompInfo::Successful ? SolveStatus::Converged
                                                             : SolveStatus::NotConverged;
   out.bands = 1;

@@ -26,6 +26,7 @@ struct Spectrum {
   long long solves = 0;
   bool cluster_truncated = false;  // lambda_m (nearly) equals lambda_{m+1}
   int coarse_functions = 0;        // solve_multilevel: N
+  FactoredBasis factored;          // solve_multilevel: H = P Z
 };
 
 Spectrum solve_dense(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M,

@@ -141,6 +141,7 @@ ManifoldHarmonics harmonics(const Sparse& K, const Sparse& M, const Sparse* leng
   ManifoldHarmonics h =
       harmonics_in_order(K_ordered, M_ordered, lengths ? &lengths_ordered : nullptr, o);
   detail::permute_rows_back(P, h.basis);
+  if (!h.factored.empty()) detail::permute_rows_back(P, h.factored.prolongation);
   return h;
 }
 
@@ -196,13 +197,16 @@ ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Spa
   out.solves = s.solves;
   out.eigenvalues = s.lambda / area;
   out.basis = std::move(s.H);
+  out.factored = std::move(s.factored);
   // Unit area, and the sign convention: each column's largest-magnitude entry positive (the
-  // columns split between two threads: two passes over n x m).
+  // columns split between two threads: two passes over n x m). A factored basis's Z alike.
   detail::split_in_two(columns, [&](Eigen::Index begin, Eigen::Index end) {
     for (Eigen::Index j = begin; j < end; ++j) {
       Eigen::Index i;
       out.basis.col(j).cwiseAbs().maxCoeff(&i);
-      out.basis.col(j) *= (out.basis(i, j) < 0 ? -1.0 : 1.0) / std::sqrt(area);
+      const double scale = (out.basis(i, j) < 0 ? -1.0 : 1.0) / std::sqrt(area);
+      out.basis.col(j) *= scale;
+      if (!out.factored.empty()) out.factored.coarse.col(j) *= scale;
     }
   });
   detail::report(o, 1.0, "verification");

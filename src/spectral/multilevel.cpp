@@ -14,54 +14,22 @@
 #include <algorithm>
 #include <cmath>
 
+#include "linalg/basis_product.h"
 #include "linalg/galerkin_product.h"
-#include "linalg/parallel.h"
 #include "specdeform/exceptions.h"
 #include "spectral/coarse_space.h"
 #include "spectral/eigensolvers.h"
 
 namespace specdeform::detail {
 
-namespace {
-
-using Mat = Eigen::MatrixXd;
-using Vec = Eigen::VectorXd;
 using Sparse = Eigen::SparseMatrix<double>;
-
-// P Z on two threads, P row-major: each row of U = P Z gathered into a tile of kTile rows
-// (row-major, m wide: the rows of Z it adds are contiguous), stored into U's columns a tile at
-// a time.
-Mat prolong(const Eigen::SparseMatrix<double, Eigen::RowMajor>& P, const Eigen::Ref<const Mat>& Z) {
-  constexpr Eigen::Index kTile = 64;
-  using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  const RowMat Zr = Z;
-  const Eigen::Index m = Z.cols();
-  Mat U(P.rows(), m);
-  split_in_two(P.rows(), [&](Eigen::Index begin, Eigen::Index end) {
-    RowMat tile(kTile, m);
-    for (Eigen::Index first = begin; first < end; first += kTile) {
-      const Eigen::Index rows = std::min(kTile, end - first);
-      tile.setZero();
-      for (Eigen::Index r = 0; r < rows; ++r) {
-        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P, first + r); it;
-             ++it) {
-          tile.row(r) += it.value() * Zr.row(it.index());
-        }
-      }
-      U.middleRows(first, rows) = tile.topRows(rows);
-    }
-  });
-  return U;
-}
-
-}  // namespace
 
 Spectrum solve_multilevel(const Sparse& K, const Sparse& M, const Sparse& lengths,
                           const ManifoldHarmonicsOptions& o) {
   const ManifoldHarmonicsPolicy& p = o.policy;
   const int m = o.num_modes;
   report(o, 0.0, "coarse space");
-  const CoarseSpace coarse = partition_of_unity(
+  CoarseSpace coarse = partition_of_unity(
       lengths, std::max(p.multilevel_min_samples, p.multilevel_samples_per_mode * m),
       p.multilevel_support);
   const Sparse& P = coarse.prolongation;
@@ -83,7 +51,10 @@ Spectrum solve_multilevel(const Sparse& K, const Sparse& M, const Sparse& length
   ManifoldHarmonics h = compute_manifold_harmonics(Kc, Mc, co);
   report(o, 0.7, "prolongation");
   Spectrum out;
-  out.H = prolong(coarse.rows, h.basis.leftCols(m));  // m columns only: no second n x m copy
+  out.factored.prolongation = std::move(coarse.rows);
+  out.factored.prolongation.makeCompressed();
+  out.factored.coarse = h.basis.leftCols(m);
+  out.H = factored_product(out.factored);
   out.lambda = std::move(h.eigenvalues);
   out.cluster_truncated =
       out.lambda.size() > m &&

@@ -2,6 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <vector>
+
+#include <Eigen/Sparse>
+
 #include "specdeform/exceptions.h"
 
 namespace specdeform {
@@ -37,6 +42,38 @@ TEST(BasisProduct, MatchesEigensProduct) {
   EXPECT_THROW(detail::add_basis_product(Eigen::MatrixX3d::Zero(4, 3), H,
                                          Eigen::MatrixX3d::Zero(2, 3), wrong),
                InputError);
+}
+
+// A factored basis H = P Z: base + P (Z C) against the product of the dense H, into both
+// outputs; P Z itself against Eigen's; sizes that do not match are refused.
+TEST(BasisProduct, FactoredMatchesTheDenseBasis) {
+  for (const int n : {1, 37, 1000, 4097}) {
+    const int N = std::max(1, n / 10);
+    std::vector<Eigen::Triplet<double>> entries;
+    for (int i = 0; i < n; ++i) {
+      for (int k = 0; k < 5; ++k) entries.emplace_back(i, (7 * i + 3 * k) % N, 0.1 + 0.2 * k);
+    }
+    FactoredBasis f;
+    f.prolongation.resize(n, N);
+    f.prolongation.setFromTriplets(entries.begin(), entries.end());
+    f.prolongation.makeCompressed();
+    f.coarse = Eigen::MatrixXd::Random(N, 13);
+    const Eigen::MatrixXd H = f.prolongation * f.coarse;
+    EXPECT_LT((detail::factored_product(f) - H).cwiseAbs().maxCoeff(), 1e-12) << n;
+    const Eigen::MatrixX3d base = Eigen::MatrixX3d::Random(n, 3),
+                           C = Eigen::MatrixX3d::Random(13, 3);
+    const Eigen::MatrixX3d expected = base + H * C;
+    Eigen::MatrixX3d out;
+    detail::add_basis_product(base, f, C, out);
+    EXPECT_LT((out - expected).cwiseAbs().maxCoeff(), 1e-12) << n;
+    FloatVertices rows(n, 3);
+    detail::add_basis_product(base, f, C, rows);
+    EXPECT_LT((rows.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-5) << n;
+    EXPECT_THROW(detail::add_basis_product(base, f, Eigen::MatrixX3d::Zero(12, 3), out),
+                 InputError);
+    FloatVertices wrong(n + 1, 3);
+    EXPECT_THROW(detail::add_basis_product(base, f, C, wrong), InputError);
+  }
 }
 
 }  // namespace

@@ -49,6 +49,61 @@ TEST_F(BasisCache, RoundTrip) {
             0.6 * std::filesystem::file_size(dir_ / "b.sdbasis"));
 }
 
+// A multilevel basis is saved as its factors: exact, smaller than the float32 basis, and read
+// back with them; a file whose factors do not make a matrix of its sizes is refused.
+TEST_F(BasisCache, FactoredRoundTrip) {
+  const TriangleMesh torus = make_torus(1.0, 0.35, 100, 40);
+  ManifoldHarmonicsOptions o;
+  o.num_modes = 60;  // below m of about 40, P Z is more bytes than H
+  o.solver = EigenSolver::Multilevel;
+  const ManifoldHarmonics h = compute_manifold_harmonics(torus, o);
+  ASSERT_TRUE(h.factored.smaller_than_dense(4));
+  save_basis(dir_ / "p.sdbasis", h, torus, BasisPrecision::Float32);
+  const ManifoldHarmonics back = load_basis(dir_ / "p.sdbasis", torus);
+  EXPECT_TRUE(back.approximate);
+  EXPECT_TRUE(back.factored.prolongation.isApprox(h.factored.prolongation, 0.0));
+  EXPECT_EQ(back.factored.coarse, h.factored.coarse);
+  EXPECT_LT((back.basis - h.basis).cwiseAbs().maxCoeff(), 1e-14 * h.basis.cwiseAbs().maxCoeff());
+  EXPECT_EQ(back.eigenvalues, h.eigenvalues);
+  ManifoldHarmonics dense = h;
+  dense.factored = FactoredBasis{};
+  save_basis(dir_ / "d.sdbasis", dense, torus, BasisPrecision::Float32);
+  EXPECT_TRUE(load_basis(dir_ / "d.sdbasis", torus).factored.empty());
+  EXPECT_LT(std::filesystem::file_size(dir_ / "p.sdbasis"),
+            std::filesystem::file_size(dir_ / "d.sdbasis"));
+
+  std::string bytes;
+  {
+    std::ifstream file(dir_ / "p.sdbasis", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(file), {});
+  }
+  const size_t m = h.basis.cols(), n = torus.num_vertices();
+  const size_t columns = 32 + 56 + 8 + 16 * m + 4 + 8 + 4 * (n + 1);  // P's first column index
+  const int32_t outside = h.coarse_functions;
+  std::string broken = bytes;
+  std::memcpy(broken.data() + columns, &outside, 4);
+  std::ofstream(dir_ / "b.sdbasis", std::ios::binary | std::ios::trunc) << broken;
+  try {
+    load_basis(dir_ / "b.sdbasis", torus);
+    FAIL() << "a column index outside P was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("corrupt basis factors"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir_ / "b.sdbasis", std::ios::binary | std::ios::trunc)
+      << bytes.substr(0, bytes.size() - 8);
+  EXPECT_THROW(load_basis(dir_ / "b.sdbasis", torus), InputError);
+  broken = bytes;  // a count of entries beyond the file's end: refused before allocating
+  const uint64_t huge = uint64_t{1} << 30;
+  std::memcpy(broken.data() + columns - 4 * (n + 1) - 8, &huge, 8);
+  std::ofstream(dir_ / "b.sdbasis", std::ios::binary | std::ios::trunc) << broken;
+  try {
+    load_basis(dir_ / "b.sdbasis", torus);
+    FAIL() << "a count of entries beyond the file's end was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(BasisCache, RecordsTheLaplacian) {
   ManifoldHarmonicsOptions o;
   o.num_modes = 10;

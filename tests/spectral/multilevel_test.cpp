@@ -87,6 +87,58 @@ TEST(MultilevelBasis, CorpusInvariants) {
   EXPECT_EQ(tried.size(), 4u) << "closed, with boundary, several components, awkward";
 }
 
+// The basis keeps its factors, H = P Z exactly (to rounding), also through the breadth-first
+// renumbering that large meshes get (forced here), and the sign convention applies to Z alike;
+// a deformer reading P Z gives the frames of the dense basis. Several pieces keep no factors.
+TEST(MultilevelBasis, KeepsItsFactors) {
+  const TriangleMesh torus = make_torus(1.0, 0.35, 100, 40);
+  for (const int reorder_from : {0, 1 << 30}) {
+    ManifoldHarmonicsOptions o;
+    o.num_modes = 60;  // below m of about 40, P Z is more bytes than H and not read per frame
+    o.solver = EigenSolver::Multilevel;
+    o.policy.reorder_from = reorder_from;
+    const ManifoldHarmonics h = compute_manifold_harmonics(torus, o);
+    ASSERT_TRUE(h.approximate);
+    ASSERT_TRUE(h.factored.smaller_than_dense(4));  // the deformers below read P Z
+    EXPECT_EQ(h.factored.prolongation.rows(), torus.num_vertices());
+    EXPECT_EQ(h.factored.coarse.rows(), h.coarse_functions);
+    const Eigen::MatrixXd PZ = h.factored.prolongation * h.factored.coarse;
+    EXPECT_LT((PZ - h.basis).cwiseAbs().maxCoeff(), 1e-13 * h.basis.cwiseAbs().maxCoeff())
+        << reorder_from;
+
+    Selection selection;
+    selection.handles.resize(1);
+    for (int i = 0; i < torus.num_vertices(); ++i) {
+      if (torus.V(i, 0) < -1.1) selection.fixed.push_back(i);
+      if (torus.V(i, 0) > 1.1) selection.handles[0].push_back(i);
+    }
+    ManifoldHarmonics dense = h;
+    dense.factored = FactoredBasis{};
+    const Eigen::Affine3d T(Eigen::Translation3d(0.1, 0.3, -0.2) *
+                            Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()));
+    for (const bool float32 : {false, true}) {
+      DeformOptions d;
+      d.float32_basis = float32;
+      SpectralDeformer factored(torus, std::make_shared<const ManifoldHarmonics>(h), d);
+      SpectralDeformer plain(torus, std::make_shared<const ManifoldHarmonics>(dense), d);
+      factored.set_selection(selection);
+      plain.set_selection(selection);
+      const double tolerance = (float32 ? 1e-5 : 1e-12) * bounding_box_diagonal(torus.V);
+      EXPECT_LT((factored.solve({T}) - plain.solve({T})).cwiseAbs().maxCoeff(), tolerance);
+      EXPECT_LT((factored.preview({T}) - plain.preview({T})).cwiseAbs().maxCoeff(), tolerance);
+    }
+  }
+  TriangleMesh two;
+  two.V.resize(2 * torus.num_vertices(), 3);
+  two.V << torus.V, torus.V.rowwise() + Eigen::RowVector3d(3.0, 0.0, 0.0);
+  two.F.resize(2 * torus.num_faces(), 3);
+  two.F << torus.F, torus.F.array() + torus.num_vertices();
+  ManifoldHarmonicsOptions o;
+  o.num_modes = 12;
+  o.solver = EigenSolver::Multilevel;
+  EXPECT_TRUE(compute_manifold_harmonics(two, o).factored.empty());
+}
+
 // A mesh smaller than multilevel_reduction times the coarse space gets the exact solver.
 TEST(MultilevelBasis, SmallMeshesAreSolvedExactly) {
   const ManifoldHarmonics h = harmonics(make_icosphere(2), 10, EigenSolver::Multilevel);

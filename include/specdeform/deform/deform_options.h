@@ -73,7 +73,8 @@ struct DeformOptions {
   DeformSolver solver = DeformSolver::Spectral;
   DetailMethod detail = DetailMethod::Transfer;
   UnconstrainedPieces unconstrained = UnconstrainedPieces::Follow;
-  bool float32_basis = false;  // keep the basis in single precision (faster frames)
+  bool float32_basis = false;  // keep the basis in single precision (faster frames; a factored
+                               // multilevel basis is read as P Z instead, faster still)
   // Transfer: build and factor its Poisson system on a background thread; until the last
   // selection's factorisation is ready, frames add the details as displacements
   // (SpectralDeformer::detail_pending). For interactive front ends.

@@ -175,6 +175,7 @@ class SpectralDeformer {
   std::vector<char> moving_;
   DeformOptions options_;
   Eigen::MatrixXf basis32_;  // float32_basis: the basis in single precision
+  bool factored_ = false;    // frames read the solve basis as P Z (fewer bytes than H)
   Vertices base_, deformed_base_;
   std::unique_ptr<ReducedSolver> reduced_;
   std::unique_ptr<SpatialSolver> spatial_;

@@ -5,6 +5,9 @@
 //   scalar u8 (8 = float64, 4 = float32) | laplacian u8 (0 cotan, 1 intrinsic-delaunay) |
 //   reserved u8 | mesh hash u64 | solver report | layout | eigenvalues (m x f64) | residuals (m x
 //   f64, version 4 on) | basis (n x m, column-major, float64 or float32)
+// or, for a factored basis (version 6 on, scalar 0), in place of the basis its factors H = P Z:
+//   N u32 | nnz u64 | P's row starts ((n + 1) x i32) | columns (nnz x i32) | values (nnz x f64) |
+//   Z (N x m, column-major, f64): exact, and about half the float32 basis's bytes at m = 100.
 // with the solver report (version 3 on) max_residual, rounding_floor, threshold,
 // max_orthogonality_error (f64 each) | bands u32 | restarts u32 | solves u64 | converged u8 |
 // cluster_truncated u8 | approximate u8 | coarse_functions u32 | 1 reserved byte (version 3:
@@ -16,7 +19,9 @@
 // are read as cotan bases; files of versions 1 and 2 read back with max_residual NaN (unknown). The
 // mesh hash covers the vertex positions and the faces, so loading refuses, with a clear message, a
 // basis that was computed for another mesh (or another version of it). float32 storage halves the
-// file; loading converts back to double. Files are written atomically.
+// file; loading converts back to double, or multiplies the factors out (the loaded basis keeps
+// them). A factored basis is saved as its factors where they are fewer bytes than the basis in
+// the precision asked for (FactoredBasis::smaller_than_dense). Files are written atomically.
 #pragma once
 
 #include <cstdint>

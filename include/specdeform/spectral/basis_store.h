@@ -39,7 +39,8 @@ std::filesystem::path cached_basis_file(const TriangleMesh& mesh,
 
 // The precision a cache keeps `basis` in: float32 for an approximate (multilevel) basis, whose
 // own error (its residuals, 1e-4 and more) is far above float32's rounding (6e-8 of each entry):
-// half the file, half its write; float64 for an exact basis.
+// half the file, half its write; float64 for an exact basis. (A factored one is kept as its
+// factors either way: basis_cache.h.)
 BasisPrecision cache_precision(const ManifoldHarmonics& basis);
 
 struct ObtainedBasis {

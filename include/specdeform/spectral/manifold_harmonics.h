@@ -14,10 +14,10 @@
 //    factored once per band with CHOLMOD, each step solves for a whole block of right-hand sides,
 //    and orthogonalises it against the basis by block Gram-Schmidt, twice, in two fused passes
 //    over the basis (the subtraction of one pass with the projection of the next; the second
-//    pass's subtraction lagged into the next block, DCGS2-style) and Cholesky QR within the block. For large m the spectrum is computed band by band
-//    (interior shifts, LDL^T with one step of iterative refinement), each band deflated
-//    against the pairs already found. K's null space (the constants of each connected
-//    component) is known exactly and deflated from the start.
+//    pass's subtraction lagged into the next block, DCGS2-style) and Cholesky QR within the block.
+//    For large m the spectrum is computed band by band (interior shifts, LDL^T with one step of
+//    iterative refinement), each band deflated against the pairs already found. K's null space (the
+//    constants of each connected component) is known exactly and deflated from the start.
 //  - Lanczos: Spectra's SymGEigsShiftSolver (implicitly restarted Lanczos, ncv = 2m + 1) on the
 //    same CHOLMOD shift-invert operator. The plain baseline.
 //  - Multilevel: an approximation for large meshes (Nasikun, Brandt & Hildebrandt, "Fast
@@ -132,9 +132,28 @@ struct ManifoldHarmonicsOptions {
 
 enum class SolveStatus { Converged, NotConverged };
 
+// A basis held as the multilevel solver makes it: H = P Z, P n x N sparse (rows summing to 1, a
+// dozen entries each), Z N x m. A frame's product H c = P (Z c) reads P, not H: at 692k
+// vertices ~100 MB against H's 553 MB (277 MB in float32).
+struct FactoredBasis {
+  Eigen::SparseMatrix<double, Eigen::RowMajor> prolongation;  // P, compressed
+  Eigen::MatrixXd coarse;                                     // Z
+
+  bool empty() const { return coarse.size() == 0; }
+  // Whether P and Z are fewer bytes than H with `scalar_bytes` (8 or 4) per entry, so that a
+  // frame's product reads less and a cache file holds less: from m of about 40 on. False when
+  // empty.
+  bool smaller_than_dense(int scalar_bytes) const {
+    return !empty() &&
+           12.0 * double(prolongation.nonZeros()) + 8.0 * double(coarse.size()) <
+               double(scalar_bytes) * double(prolongation.rows()) * double(coarse.cols());
+  }
+};
+
 struct ManifoldHarmonics {
   Eigen::VectorXd eigenvalues;  // m (more on several pieces), ascending, mesh units
   Eigen::MatrixXd basis;        // n x m, H^T M H = I
+  FactoredBasis factored;       // the multilevel basis of one piece: basis = P Z; else empty
   MassType mass = MassType::Lumped;
   LaplacianType laplacian = LaplacianType::Cotan;  // H is orthonormal in this Laplacian's M
 
