@@ -161,8 +161,8 @@ def update(obj, b, depsgraph=None, full=False):
         pending = False
     quick = (not final and not pending and obj.specdeform.quick_drags
              and b.full_ms > QUICK_ABOVE_MS)
-    if quick and isinstance(b.used, slice):  # straight into the positions, no temporary
-        b.deformer.preview(T, out=b.positions)
+    if isinstance(b.used, slice):  # straight into the positions, no temporary
+        (b.deformer.preview if quick else b.deformer.solve)(T, out=b.positions)
     else:
         b.positions[b.used] = b.deformer.preview(T) if quick else b.deformer.solve(T)
     solved = time.perf_counter()

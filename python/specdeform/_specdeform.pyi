@@ -232,7 +232,11 @@ class SpectralDeformer:
     def set_selection(
         self, handles: Sequence[npt.ArrayLike], fixed: npt.ArrayLike = ()
     ) -> None: ...
-    def solve(self, transforms: npt.ArrayLike | Sequence[npt.ArrayLike]) -> _Float: ...
+    def solve(
+        self,
+        transforms: npt.ArrayLike | Sequence[npt.ArrayLike],
+        out: npt.NDArray[np.float32] | None = None,
+    ) -> npt.NDArray[np.floating]: ...
     def preview(
         self,
         transforms: npt.ArrayLike | Sequence[npt.ArrayLike],

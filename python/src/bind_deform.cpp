@@ -42,6 +42,19 @@ Selection to_selection(py::handle handles, py::handle fixed, Eigen::Index n) {
   return s;
 }
 
+// `out` of solve() and preview(): a writeable C-contiguous float32 (n, 3) array, in place.
+Eigen::Map<FloatVertices> vertex_buffer(py::handle out, const Deformer& d,
+                                        const std::string& call) {
+  const Eigen::Index n = d.deformer->mesh().num_vertices();
+  auto buffer = py::cast<py::array>(out);
+  if (!py::isinstance<py::array_t<float>>(buffer) || buffer.ndim() != 2 || buffer.shape(0) != n ||
+      buffer.shape(1) != 3 || !buffer.writeable() || !(buffer.flags() & py::array::c_style)) {
+    throw InputError(call + ": out must be a writeable C-contiguous float32 (" + std::to_string(n) +
+                     ", 3) array");
+  }
+  return Eigen::Map<FloatVertices>(static_cast<float*>(buffer.mutable_data()), n, 3);
+}
+
 py::array index_array(const std::vector<int>& v) {
   return to_array(Eigen::VectorXi(Eigen::Map<const Eigen::VectorXi>(v.data(), v.size())));
 }
@@ -157,8 +170,15 @@ empty (InputError otherwise); fixed: the vertices held in place. A vertex may be
 only.)")
       .def(
           "solve",
-          [](Deformer& d, py::handle transforms) {
+          [](Deformer& d, py::handle transforms, py::handle out) -> py::object {
             const std::vector<Eigen::Affine3d> t = to_transforms(transforms);
+            if (!out.is_none()) {
+              Eigen::Map<FloatVertices> rows = vertex_buffer(out, d, "solve");
+              py::gil_scoped_release release;
+              const std::lock_guard lock(d.mutex);
+              d.deformer->solve(t, rows);
+              return py::reinterpret_borrow<py::object>(out);
+            }
             Vertices result;
             {
               py::gil_scoped_release release;
@@ -167,9 +187,10 @@ only.)")
             }
             return to_array(std::move(result));
           },
-          py::arg("transforms"),
+          py::arg("transforms"), py::arg("out") = py::none(),
           R"(The deformed mesh (n, 3) for one 4 x 4 affine transform per handle group (a list, a
-(k, 4, 4) array, or one matrix for one group).)")
+(k, 4, 4) array, or one matrix for one group). out: as preview() takes it, a float32 (n, 3)
+C-contiguous array written in place and returned.)")
       .def(
           "preview",
           [](Deformer& d, py::handle transforms, py::handle vertices,
@@ -178,14 +199,7 @@ only.)")
             const int n = d.deformer->mesh().num_vertices();
             if (!out.is_none()) {
               if (!vertices.is_none()) throw InputError("preview: out is for every vertex");
-              auto buffer = py::cast<py::array>(out);
-              if (!py::isinstance<py::array_t<float>>(buffer) || buffer.ndim() != 2 ||
-                  buffer.shape(0) != n || buffer.shape(1) != 3 || !buffer.writeable() ||
-                  !(buffer.flags() & py::array::c_style)) {
-                throw InputError("preview: out must be a writeable C-contiguous float32 (" +
-                                 std::to_string(n) + ", 3) array");
-              }
-              Eigen::Map<FloatVertices> rows(static_cast<float*>(buffer.mutable_data()), n, 3);
+              Eigen::Map<FloatVertices> rows = vertex_buffer(out, d, "preview");
               py::gil_scoped_release release;
               const std::lock_guard lock(d.mutex);
               d.deformer->preview(t, rows);

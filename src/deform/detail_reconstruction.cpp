@@ -517,13 +517,22 @@ void DetailReconstruction::on_ready(std::function<void()> callback) {
 }
 
 Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& anchors) {
+  Vertices out;
+  apply(s, anchors, out);
+  return out;
+}
+
+void DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& anchors,
+                                 Vertices& out) {
   applied_ = method_;
   fold_zone_ = 0;
   switch (method_) {
     case DetailMethod::None:
-      return s;
+      out = s;
+      return;
     case DetailMethod::Displacement:
-      return s + details_;
+      out = s + details_;
+      return;
     case DetailMethod::Frames: {
       const auto normals = vertex_normals(TriangleMesh{s, faces_});
       const detail::RowVertices deformed = s;
@@ -534,7 +543,7 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
       std::vector<char> unturned(s.rows(), 0);
       for (const int f : zone)
         for (int k = 0; k < 3; ++k) unturned[faces_(f, k)] = 1;
-      Vertices out(s.rows(), 3);
+      out.resize(s.rows(), 3);
       detail::split_in_two(s.rows(), [&](Eigen::Index begin, Eigen::Index end) {
         for (Eigen::Index i = begin; i < end; ++i) {
           const int size = ring_start_[i + 1] - ring_start_[i];
@@ -549,12 +558,13 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
           }
         }
       });
-      return out;
+      return;
     }
     case DetailMethod::Transfer:
       if (!ready()) {
         applied_ = DetailMethod::Displacement;
-        return s + details_;
+        out = s + details_;
+        return;
       }
       break;
   }
@@ -583,11 +593,10 @@ Vertices DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& 
       x.row(it.row()) -= it.value() * anchors.row(i);
   for (size_t i = 0; i < p.anchors.size(); ++i) x.row(p.anchors[i]) = anchors.row(i);
   p.system->solve_in_place(x.data());
-  Vertices out(n, 3);
+  out.resize(n, 3);
   detail::split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
     for (Eigen::Index k = begin; k < end; ++k) out.row(p.order[k]) = x.row(k);
   });
-  return out;
 }
 
 }  // namespace specdeform

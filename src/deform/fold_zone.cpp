@@ -59,6 +59,26 @@ __attribute__((target_clones("avx2", "default"))) void unit_normals(const int* f
   }
 }
 
+// Appends to `out` the faces of [begin, end) that fold: they agreed with their edge neighbours at
+// rest, and their unit normal now points against the sum of the neighbours' (-1: none).
+__attribute__((target_clones("avx2", "default"))) void folded_faces(const int* neighbours,
+                                                                    const char* agreed,
+                                                                    const double* normals,
+                                                                    int begin, int end,
+                                                                    std::vector<int>& out) {
+  for (int f = begin; f < end; ++f) {
+    if (!agreed[f]) continue;
+    double sum[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 3; ++k) {
+      const int g = neighbours[3 * f + k];
+      if (g < 0) continue;
+      for (int d = 0; d < 3; ++d) sum[d] += normals[3 * g + d];
+    }
+    const double* n = normals + 3 * f;
+    if (n[0] * sum[0] + n[1] * sum[1] + n[2] * sum[2] < 0.0) out.push_back(f);
+  }
+}
+
 }  // namespace
 
 Eigen::Matrix3d triangle_frame(const Eigen::Matrix3d& corners) {
@@ -121,11 +141,8 @@ std::vector<int> FoldZone::find(const RowVertices& deformed, const RowVertices& 
   const int nf = static_cast<int>(faces_.rows());
   std::vector<int> folded[2];
   split_in_two(nf, [&](Eigen::Index begin, Eigen::Index end) {
-    std::vector<int>& out = folded[end == nf ? 1 : 0];  // split_in_two: (half, nf), (0, half)
-    for (Eigen::Index f = begin; f < end; ++f) {
-      if (agreed_[f] && normals.row(f).dot(neighbour_normals(normals, f)) < 0.0)
-        out.push_back(static_cast<int>(f));
-    }
+    folded_faces(neighbours_.data(), agreed_.data(), normals.data(), static_cast<int>(begin),
+                 static_cast<int>(end), folded[end == nf ? 1 : 0]);  // (half, nf), (0, half)
   });
   std::vector<int> zone = std::move(folded[0]);
   zone.insert(zone.end(), folded[1].begin(), folded[1].end());

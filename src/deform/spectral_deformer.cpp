@@ -8,6 +8,7 @@
 #include "deform/moving_basis.h"
 #include "deform/reduced_forms.h"
 #include "linalg/basis_product.h"
+#include "linalg/parallel.h"
 #include "specdeform/deform/reduced_solver.h"
 #include "specdeform/deform/spatial_solver.h"
 #include "specdeform/exceptions.h"
@@ -68,7 +69,10 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh, ManifoldHarmonics basis,
 SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
                                    std::shared_ptr<const ManifoldHarmonics> basis,
                                    const DeformOptions& options)
-    : mesh_(std::move(mesh)), basis_(std::move(basis)), options_(options) {
+    : mesh_(std::move(mesh)),
+      diagonal_(bounding_box_diagonal(mesh_.V)),
+      basis_(std::move(basis)),
+      options_(options) {
   options_.validate();
   const int n = mesh_.num_vertices();
   const bool has_basis = basis_ && basis_->basis.cols() > 0;
@@ -319,6 +323,24 @@ Vertices SpectralDeformer::preview(const std::vector<Eigen::Affine3d>& transform
 }
 
 Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms) {
+  Vertices result;
+  solve(transforms, result);
+  return result;
+}
+
+void SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms,
+                             Eigen::Ref<FloatVertices> out) {
+  if (out.rows() != mesh_.num_vertices()) {
+    throw InputError("solve: an output of " + std::to_string(out.rows()) + " rows for " +
+                     std::to_string(mesh_.num_vertices()) + " vertices");
+  }
+  solve(transforms, result_);
+  detail::split_in_two(out.rows(), [&](Eigen::Index begin, Eigen::Index end) {
+    out.middleRows(begin, end - begin) = result_.middleRows(begin, end - begin).cast<float>();
+  });
+}
+
+void SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms, Vertices& result) {
   Clock total;
   const Eigen::MatrixX3d base_targets = solve_coefficients(transforms);
   Clock clock;
@@ -331,10 +353,9 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
     base_miss_.max = std::max(base_miss_.max, d);
     base_miss_.rms += d * d;
   }
-  const double diagonal = bounding_box_diagonal(mesh_.V);
-  base_miss_.max /= diagonal;
+  base_miss_.max /= diagonal_;
   base_miss_.rms =
-      std::sqrt(base_miss_.rms / std::max<size_t>(constrained_.first_free, 1)) / diagonal;
+      std::sqrt(base_miss_.rms / std::max<size_t>(constrained_.first_free, 1)) / diagonal_;
   double deferred = 0.0;
   if (options_.single_solve) {  // the solvers' memory back before the details take theirs
     clock.lap();
@@ -352,7 +373,7 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
   detail_targets_ = options_.detail == DetailMethod::None
                         ? base_targets
                         : constraint_targets(constrained_, mesh_.V, transforms);
-  Vertices result = details_->apply(deformed_base_, detail_targets_);
+  details_->apply(deformed_base_, detail_targets_, result);
   if (follow_) {
     const Vertices& rest = options_.detail == DetailMethod::None ? base_ : mesh_.V;
     const std::vector<Eigen::Affine3d> motions = follow_->motions(rest, result);
@@ -368,7 +389,6 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
   }
   frame_.detail = clock.lap();
   frame_.total = total.lap() - deferred;
-  return result;
 }
 
 ConstraintError SpectralDeformer::constraint_error(const Vertices& result) const {

@@ -118,6 +118,15 @@ TEST(SpectralDeformer, APreviewIsTheFrameWithDisplacements) {
   EXPECT_LT((buffer.cast<double>() - expected_quick).cwiseAbs().maxCoeff(), 1e-5 * diagonal);
   FloatVertices short_buffer(3, 3);
   EXPECT_THROW(transfer.preview({turn}, short_buffer), InputError);
+  // solve() into a buffer: the transfer's frame, twice (its kept frame reused), as solve() gives
+  // it.
+  for (int k = 0; k < 2; ++k) {
+    transfer.solve({turn}, buffer);
+    EXPECT_LT((buffer.cast<double>() - transfer.solve({turn})).cwiseAbs().maxCoeff(),
+              1e-6 * diagonal);
+  }
+  EXPECT_GT((buffer.cast<double>() - expected_quick).cwiseAbs().maxCoeff(), 1e-4 * diagonal);
+  EXPECT_THROW(transfer.solve({turn}, short_buffer), InputError);
   EXPECT_GT((quick - s.mesh.V).norm(), 0.05);
   // A sphere beside the bar, with no handle or fixed vertex: it follows the bar's base.
   TriangleMesh two = test::concatenate(s.mesh, make_icosphere(1));

@@ -432,9 +432,9 @@ def test_preview_is_the_frame_with_the_details_as_displacements(bar):
         transfer.preview(T, [len(V)])
 
 
-def test_preview_into_a_float32_buffer(bar):
-    """preview(T, out=buffer) writes the frame into the caller's float32 rows and returns them;
-    anything else for out is an InputError."""
+def test_frames_into_a_float32_buffer(bar):
+    """preview(T, out=buffer) and solve(T, out=buffer) write the frame into the caller's float32
+    rows and return them; anything else for out is an InputError."""
     V, F = bar
     d = specdeform.SpectralDeformer(V, F, basis=specdeform.manifold_harmonics(V, F, 20))
     d.set_selection([V[:, 0] > 3.5], V[:, 0] < 0.5)
@@ -448,3 +448,8 @@ def test_preview_into_a_float32_buffer(bar):
             d.preview(T, out=wrong)
     with pytest.raises(specdeform.InputError, match="every vertex"):
         d.preview(T, [0], out=buffer)
+    assert d.solve(T, out=buffer) is buffer  # the frame with the transfer's details
+    assert relative_difference(buffer, d.solve(T), V) < 1e-6
+    assert relative_difference(buffer, d.preview(T), V) > 1e-4
+    with pytest.raises(specdeform.InputError, match="solve: out must be"):
+        d.solve(T, out=np.zeros(V.shape))

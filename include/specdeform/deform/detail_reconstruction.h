@@ -82,6 +82,9 @@ class DetailReconstruction {
   // anchor_positions: exact positions of the anchors (n' x 3, Transfer only). Reuses buffers
   // of the previous call (not reentrant).
   Vertices apply(const Vertices& deformed_base, const Eigen::MatrixX3d& anchor_positions);
+  // The same into `out` (resized to n x 3; not reallocated when it fits, not deformed_base).
+  void apply(const Vertices& deformed_base, const Eigen::MatrixX3d& anchor_positions,
+             Vertices& out);
 
   DetailMethod method() const { return method_; }
   DetailMethod applied() const { return applied_; }  // by the last apply()

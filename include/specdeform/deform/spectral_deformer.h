@@ -88,6 +88,10 @@ class SpectralDeformer {
 
   // The deformed detailed mesh (n x 3) for one transform per handle group.
   Vertices solve(const std::vector<Eigen::Affine3d>& transforms);
+  // The same written into `out` (n rows, InputError otherwise), a front end's own vertex buffer,
+  // through a frame kept between calls: nothing the size of the mesh is allocated per frame
+  // (in Blender, whose allocator returns a freed frame to the system, 10-20 ms of page faults).
+  void solve(const std::vector<Eigen::Affine3d>& transforms, Eigen::Ref<FloatVertices> out);
 
   // A quick look at a frame for drags (the editor's coarse preview): the detailed mesh at
   // `vertices` only (k x 3, in their order), the smooth base solved as solve() solves it (warm
@@ -156,6 +160,8 @@ class SpectralDeformer {
   // The reduced (or spatial) solve of a frame: state_, arap_report_ and frame_.reduced_solve.
   // Returns the smooth base's targets of the constrained vertices.
   Eigen::MatrixX3d solve_coefficients(const std::vector<Eigen::Affine3d>& transforms);
+  // solve() into `result` (resized to n x 3; not reallocated when it fits).
+  void solve(const std::vector<Eigen::Affine3d>& transforms, Vertices& result);
   // deformed = origin + H c (or + d), free pieces' rows those of origin (base_: the deformed
   // base; mesh_.V: the details added as displacements).
   void inverse_transform(const Vertices& origin, Vertices& deformed) const;
@@ -168,6 +174,7 @@ class SpectralDeformer {
                      const std::vector<char>& moving = {});
 
   TriangleMesh mesh_;
+  double diagonal_;  // of mesh_'s bounding box
   std::shared_ptr<const ManifoldHarmonics> basis_;
   // The basis the spectral solvers work in: basis_, or on several pieces under soft
   // constraints the modes of the pieces with a handle (deform/moving_basis.h), for moving_.
@@ -177,6 +184,7 @@ class SpectralDeformer {
   Eigen::MatrixXf basis32_;  // float32_basis: the basis in single precision
   bool factored_ = false;    // frames read the solve basis as P Z (fewer bytes than H)
   Vertices base_, deformed_base_;
+  Vertices result_;  // the frame of solve() into a front end's buffer
   std::unique_ptr<ReducedSolver> reduced_;
   std::unique_ptr<SpatialSolver> spatial_;
   std::unique_ptr<ArapSolver> arap_;
