@@ -216,18 +216,33 @@ export class EditorState {
   }
 
   counts(): { handles: number; fixed: number; pinned: number; groups: number } {
-    // Called on each change the panel shows (each progress message): one pass, no allocation
-    // per vertex.
-    const perLabel = new Int32Array(1 << 15); // every Int16 label
+    // Called on each change the panel shows (each progress message): one pass, nothing
+    // allocated.
+    const perLabel = this.perLabel.fill(0);
     const labels = this.labels;
-    for (let v = 0; v < labels.length; ++v) if (labels[v] > 0) ++perLabel[labels[v]];
+    let top: number = FIXED;
+    for (let v = 0; v < labels.length; ++v) {
+      const l = labels[v];
+      if (l <= FREE) continue;
+      ++perLabel[l];
+      if (l > top) top = l;
+    }
     let handles = 0, pinned = 0, groups = 0;
-    for (let l = 2; l < perLabel.length; ++l) {
+    for (let l = FIXED + 1; l <= top; ++l) {
       if (perLabel[l] === 0) continue;
-      if (this.groups[l - 2]?.pinned) pinned += perLabel[l];
+      if (this.kindOf(l) === 'pinned') pinned += perLabel[l];
       else [handles, groups] = [handles + perLabel[l], groups + 1];
     }
     return { handles, fixed: perLabel[FIXED], pinned, groups };
+  }
+  private perLabel = new Int32Array(1 << 15); // a count for every Int16 label
+
+  // What a label stands for, as the colours and the counts read it: 0 free, 1 fixed, 2 + g the
+  // handle group g, pinned or not (a label whose group is not known yet is a handle).
+  private kindOf(label: number): 'free' | 'fixed' | 'pinned' | 'handle' {
+    if (label === FREE) return 'free';
+    if (label === FIXED) return 'fixed';
+    return this.groups[label - 2]?.pinned ? 'pinned' : 'handle';
   }
 
   settled(): boolean {
@@ -626,13 +641,17 @@ export class EditorState {
     if (held) vertices = undefined;
     // Each label's colour as the buffer holds it (0 free, 1 fixed, 2 + g group g), then the
     // held free vertices': no per-vertex object or rounding (the first paint covers 692k).
+    // The table covers every group's label and those of the vertices painted (a stroke's
+    // repaint reads only its own vertices' labels).
     const labels = this.labels;
-    let top: number = FIXED;
-    for (let v = 0; v < n; ++v) if (labels[v] > top) top = labels[v];
+    let top = this.groups.length + 1;
+    if (vertices) for (let i = 0; i < vertices.length; ++i) top = Math.max(top, labels[vertices[i]]);
+    else for (let v = 0; v < n; ++v) if (labels[v] > top) top = labels[v];
     const table = new Float32Array(3 * (top + 2));
     for (let l = 0; l <= top; ++l) {
-      const c = l === FREE ? FREE_COLOR : l === FIXED ? FIXED_COLOR
-        : this.groups[l - 2]?.pinned ? PIN_COLOR : GROUP_COLORS[(l - 2) % GROUP_COLORS.length];
+      const kind = this.kindOf(l);
+      const c = kind === 'free' ? FREE_COLOR : kind === 'fixed' ? FIXED_COLOR
+        : kind === 'pinned' ? PIN_COLOR : GROUP_COLORS[(l - 2) % GROUP_COLORS.length];
       table.set([c.r, c.g, c.b], 3 * l);
     }
     const heldAt = 3 * (top + 1);
