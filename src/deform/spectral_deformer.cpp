@@ -21,6 +21,14 @@ namespace specdeform {
 
 namespace {
 
+// A front end's vertex buffer for `call` must have a row per vertex.
+void check_rows(const char* call, Eigen::Index rows, int vertices) {
+  if (rows != vertices) {
+    throw InputError(std::string(call) + ": an output of " + std::to_string(rows) + " rows for " +
+                     std::to_string(vertices) + " vertices");
+  }
+}
+
 class Clock {
  public:
   double lap() {
@@ -274,10 +282,7 @@ Vertices SpectralDeformer::preview(const std::vector<Eigen::Affine3d>& transform
 
 void SpectralDeformer::preview(const std::vector<Eigen::Affine3d>& transforms,
                                Eigen::Ref<FloatVertices> out) {
-  if (out.rows() != mesh_.num_vertices()) {
-    throw InputError("preview: an output of " + std::to_string(out.rows()) + " rows for " +
-                     std::to_string(mesh_.num_vertices()) + " vertices");
-  }
+  check_rows("preview", out.rows(), mesh_.num_vertices());
   if (follow_ || !reduced_) {  // through the frame in double precision
     out = preview(transforms).cast<float>();
     return;
@@ -330,10 +335,7 @@ Vertices SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms)
 
 void SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms,
                              Eigen::Ref<FloatVertices> out) {
-  if (out.rows() != mesh_.num_vertices()) {
-    throw InputError("solve: an output of " + std::to_string(out.rows()) + " rows for " +
-                     std::to_string(mesh_.num_vertices()) + " vertices");
-  }
+  check_rows("solve", out.rows(), mesh_.num_vertices());
   solve(transforms, result_);
   detail::split_in_two(out.rows(), [&](Eigen::Index begin, Eigen::Index end) {
     out.middleRows(begin, end - begin) = result_.middleRows(begin, end - begin).cast<float>();

@@ -79,29 +79,24 @@ TEST_F(BasisCache, FactoredRoundTrip) {
   }
   const size_t m = h.basis.cols(), n = torus.num_vertices();
   const size_t columns = 32 + 56 + 8 + 16 * m + 4 + 8 + 4 * (n + 1);  // P's first column index
-  const int32_t outside = h.coarse_functions;
-  std::string broken = bytes;
-  std::memcpy(broken.data() + columns, &outside, 4);
-  std::ofstream(dir_ / "b.sdbasis", std::ios::binary | std::ios::trunc) << broken;
-  try {
-    load_basis(dir_ / "b.sdbasis", torus);
-    FAIL() << "a column index outside P was accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("corrupt basis factors"), std::string::npos) << e.what();
-  }
+  // The file's bytes with `value` written at `offset`: refused with `message`.
+  const auto refused = [&](size_t offset, const auto value, const std::string& message) {
+    std::string broken = bytes;
+    std::memcpy(broken.data() + offset, &value, sizeof value);
+    std::ofstream(dir_ / "b.sdbasis", std::ios::binary | std::ios::trunc) << broken;
+    try {
+      load_basis(dir_ / "b.sdbasis", torus);
+      ADD_FAILURE() << "accepted: " << message;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  };
+  refused(columns, int32_t{h.coarse_functions}, "corrupt basis factors");  // outside P
+  // A count of entries beyond the file's end: refused before allocating.
+  refused(columns - 4 * (n + 1) - 8, uint64_t{1} << 30, "truncated");
   std::ofstream(dir_ / "b.sdbasis", std::ios::binary | std::ios::trunc)
       << bytes.substr(0, bytes.size() - 8);
   EXPECT_THROW(load_basis(dir_ / "b.sdbasis", torus), InputError);
-  broken = bytes;  // a count of entries beyond the file's end: refused before allocating
-  const uint64_t huge = uint64_t{1} << 30;
-  std::memcpy(broken.data() + columns - 4 * (n + 1) - 8, &huge, 8);
-  std::ofstream(dir_ / "b.sdbasis", std::ios::binary | std::ios::trunc) << broken;
-  try {
-    load_basis(dir_ / "b.sdbasis", torus);
-    FAIL() << "a count of entries beyond the file's end was accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
-  }
 }
 
 TEST_F(BasisCache, RecordsTheLaplacian) {
