@@ -13,6 +13,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "file_layout.h"
 #include "linalg/parallel.h"
 #include "mesh_writers.h"
 #include "polygon_soup.h"

@@ -34,23 +34,6 @@ struct KeptRecord {
   FileLayout layout;
 };
 
-// The first bytes of an STL file of `size` bytes: a binary one's triangles there are checked for
-// NaN and infinite coordinates before the rest is read (a garbage file is refused at once).
-void check_stl_start(std::string_view start, uint64_t size, const std::string& name);
-
-// Each reader throws InputError("<name>: <problem>") for malformed data; with `keep`, it records
-// the file there as well.
-PolygonSoup parse_obj(std::string_view data, const std::string& name, KeptRecord* keep);
-PolygonSoup parse_off(std::string_view data, const std::string& name, KeptRecord* keep);
-PolygonSoup parse_ply(std::string_view data, const std::string& name, KeptRecord* keep);
-PolygonSoup parse_stl(std::string_view data, const std::string& name, KeptRecord* keep);
-PolygonSoup parse_gltf(std::string_view data, MeshFormat format, const std::string& name,
-                       const FileResolver& companions, KeptRecord* keep);
-
-// An OBJ's materials completed from the MTL files it names (Kd, map_Kd), read through its
-// companions; those it cannot read stay plain.
-void read_obj_materials(MeshFile& file);
-
 // Hashes a position's bits (callers add +0.0 first, so that -0.0 and +0.0 weld).
 struct PositionHash {
   size_t operator()(const std::array<double, 3>& p) const {

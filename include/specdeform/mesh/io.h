@@ -18,7 +18,7 @@
 //    where their positions coincide exactly (the file's numbering stays the file's).
 //  - STL: ascii and binary; exactly coincident corners are welded into shared vertices, so file
 //    triangle t has the corners F(t, 0..2) (no triangle is reordered).
-//  - glTF 2.0 (gltf_reader.h): the triangle primitives of the meshes the default scene draws, in
+//  - glTF 2.0 (src/mesh/formats/gltf): the triangle primitives of the meshes the default scene draws, in
 //    world space; the vertices glTF splits along seams welded by position.
 // Every reader validates what it reads and throws InputError with a one-line message naming the
 // file: empty file, header only, no faces, index out of range, NaN/Inf coordinates, truncated

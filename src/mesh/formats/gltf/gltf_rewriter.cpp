@@ -5,9 +5,10 @@
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
-#include "file_normals.h"
-#include "file_rewriters.h"
-#include "float_cast.h"
+#include "gltf.h"
+#include "mesh/file_layout.h"
+#include "mesh/file_normals.h"
+#include "mesh/float_cast.h"
 #include "specdeform/exceptions.h"
 
 namespace specdeform::detail {

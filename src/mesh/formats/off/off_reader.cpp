@@ -1,7 +1,8 @@
 #include <string>
 
-#include "polygon_soup.h"
-#include "text_scanner.h"
+#include "mesh/polygon_soup.h"
+#include "mesh/text_scanner.h"
+#include "off.h"
 
 namespace specdeform::detail {
 

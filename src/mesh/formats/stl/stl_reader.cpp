@@ -5,8 +5,9 @@
 #include <string>
 #include <unordered_map>
 
-#include "polygon_soup.h"
-#include "text_scanner.h"
+#include "mesh/polygon_soup.h"
+#include "mesh/text_scanner.h"
+#include "stl.h"
 
 namespace specdeform::detail {
 

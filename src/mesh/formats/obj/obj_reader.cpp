@@ -3,8 +3,9 @@
 #include <string>
 
 #include "linalg/parallel.h"
-#include "polygon_soup.h"
-#include "text_scanner.h"
+#include "mesh/polygon_soup.h"
+#include "mesh/text_scanner.h"
+#include "obj.h"
 
 namespace specdeform::detail {
 

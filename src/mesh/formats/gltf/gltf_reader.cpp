@@ -17,7 +17,8 @@
 
 #include <Eigen/Geometry>
 
-#include "polygon_soup.h"
+#include "gltf.h"
+#include "mesh/polygon_soup.h"
 #include "specdeform/exceptions.h"
 
 namespace specdeform::detail {
