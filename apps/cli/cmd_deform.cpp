@@ -56,6 +56,8 @@ void add_deform_command(CLI::App& app) {
     options.validate();
     int modes = args->modes;
     if (cmd->count("--modes") == 0 && scene.modes) modes = *scene.modes;
+    modes = modes_for(modes, cmd->count("--modes") > 0 || scene.modes.has_value(),
+                      loaded.mesh.num_vertices());
 
     // Every check of the selection before the basis, which may take long.
     const ConstrainedSet constrained =

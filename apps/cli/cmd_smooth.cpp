@@ -24,9 +24,11 @@ void add_smooth_command(CLI::App& app) {
                   "basis cache: read if it exists (and matches the mesh), written otherwise");
   add_harmonics_options(*cmd, args->options);
   add_write_options(*cmd, args->write);
-  cmd->callback([args] {
+  cmd->callback([args, cmd] {
     const LoadedMesh loaded = load_mesh(args->mesh);
-    const auto basis = obtain_basis(loaded.mesh, args->options, args->basis);
+    ManifoldHarmonicsOptions o = args->options;
+    o.num_modes = modes_for(o.num_modes, cmd->count("--modes") > 0, loaded.mesh.num_vertices());
+    const auto basis = obtain_basis(loaded.mesh, o, args->basis);
     const ManifoldHarmonics& h = *basis;
     const auto M = mass_matrix(loaded.mesh, h.mass, h.laplacian);
     const Eigen::MatrixXd smooth =

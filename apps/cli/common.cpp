@@ -294,6 +294,16 @@ FrameTimings median_frame(SpectralDeformer& deformer,
   return {median(reduced), median(inverse), median(detail), median(total)};
 }
 
+int modes_for(int requested, bool asked, int vertices) {
+  if (asked) return requested;
+  const int modes = default_modes(vertices);
+  if (modes < requested) {
+    std::cerr << "note: m = " << modes << ": the mesh has only " << vertices
+              << " vertices (the default is " << requested << " modes)\n";
+  }
+  return modes;
+}
+
 std::shared_ptr<const ManifoldHarmonics> obtain_basis(const TriangleMesh& mesh,
                                                       const ManifoldHarmonicsOptions& options,
                                                       const std::string& cache, bool* loaded) {

@@ -90,6 +90,10 @@ struct LoadedScene {
 LoadedScene load_scene(const std::string& mesh_path, const SceneArgs& args,
                        const DeformOptions& defaults);
 
+// m for a mesh of `vertices` vertices: `requested` where the user asked for it (-m, a scene's
+// "modes"), else the default, lowered to the mesh's vertices with a note on stderr.
+int modes_for(int requested, bool asked, int vertices);
+
 // Solves the same frame `repeat` times; the median of each stage's time, and the last result.
 FrameTimings median_frame(SpectralDeformer& deformer,
                           const std::vector<Eigen::Affine3d>& transforms, int repeat,

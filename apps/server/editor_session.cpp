@@ -657,8 +657,13 @@ void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
   if (n < 4) throw InputError(name + ": too few vertices to deform");
   auto next = std::make_unique<State>();
   State& s = *next;
-  s.modes = std::min(modes, n - 1);
+  s.modes = std::min(modes, n - 1);  // every eigensolver takes m < n
   s.options = options;
+  if (s.modes < modes) {
+    send_(false, dump({{"type", "note"},
+                       {"message", name + ": m = " + std::to_string(s.modes) +
+                                       ": the mesh has only " + std::to_string(n) + " vertices"}}));
+  }
   s.appearance = file_appearance(mesh);
   // Drawn at once: the page shows it, and handles are painted, while the basis computes.
   send_mesh(mesh.mesh, s.appearance, mesh);

@@ -129,7 +129,15 @@ selection and solve() once per frame.)")
                shared = to_basis(basis, mesh, mass_type, modes);
              } else if (options.solver == DeformSolver::Spectral) {
                ManifoldHarmonicsOptions o;
-               o.num_modes = modes.value_or(o.num_modes);
+               o.num_modes = modes.value_or(default_modes(mesh.num_vertices()));
+               if (!modes && o.num_modes < ManifoldHarmonicsOptions{}.num_modes) {
+                 const std::string note =
+                     "SpectralDeformer: modes = " + std::to_string(o.num_modes) +
+                     ": the mesh has only " + std::to_string(mesh.num_vertices()) + " vertices";
+                 if (PyErr_WarnEx(PyExc_UserWarning, note.c_str(), 1) != 0) {
+                   throw py::error_already_set();
+                 }
+               }
                o.mass = mass_type.value_or(MassType::Lumped);
                o.tolerance = tolerance;
                const auto start = std::chrono::steady_clock::now();
@@ -145,7 +153,8 @@ selection and solve() once per frame.)")
            py::kw_only(), py::arg("mass") = py::none(), py::arg("cache") = py::none(),
            py::arg("progress") = py::none(),
            py::arg("tolerance") = ManifoldHarmonicsOptions{}.tolerance,
-           R"(V (n, 3), F (f, 3); modes: the harmonics used (default 100, or all of `basis`);
+           R"(V (n, 3), F (f, 3); modes: the harmonics used (default 100, lowered with a warning to
+n - 1 for a mesh of fewer vertices, or all of `basis`);
 basis: (evals, evecs) from manifold_harmonics (shared, not copied) or any M-orthonormal
 eigenpairs (copied); mass, cache, progress, tolerance: as manifold_harmonics takes them, when
 the basis is computed here. With solver="spatial" and no basis, the base is the mesh itself.

@@ -117,7 +117,8 @@ Eigen::MatrixX3d constraint_targets(const ConstrainedSet& set, const Eigen::Matr
     }
   }
   // Targets far beyond the constrained region's size (a translation of 1e300, say) would give
-  // overflowing or meaningless results: refused.
+  // overflowing or meaningless results: refused. The mesh's size stands in for a region of one
+  // vertex (a handle of one vertex, nothing fixed).
   Eigen::MatrixX3d targets(set.vertices.size(), 3);
   Eigen::AlignedBox3d box;
   double moved = 0.0;
@@ -127,7 +128,10 @@ Eigen::MatrixX3d constraint_targets(const ConstrainedSet& set, const Eigen::Matr
     box.extend(p);
     moved = std::max(moved, (targets.row(i).transpose() - p).norm());
   }
-  const double size = set.vertices.empty() ? 0.0 : std::max(box.diagonal().norm(), 1e-300);
+  double size = set.vertices.empty() ? 0.0 : std::max(box.diagonal().norm(), 1e-300);
+  if (!(moved <= kLargestMove * size) && positions.rows() > 0) {
+    size = std::max(size, (positions.colwise().maxCoeff() - positions.colwise().minCoeff()).norm());
+  }
   if (!(moved <= kLargestMove * size)) {
     throw InputError("deformation: a handle moves its vertices " + std::to_string(moved) +
                      ", more than " + std::to_string(static_cast<long>(kLargestMove)) +

@@ -196,6 +196,9 @@ LoadedMesh read_mesh_from_memory(std::string_view data, MeshFormat format, std::
                                  const ReadOptions& options) {
   const std::string n(name);
   detail::reject_git_lfs_pointer(data, n, "mesh");
+  const bool gltf = format == MeshFormat::Gltf || format == MeshFormat::Glb;
+  const FileResolver companions =
+      gltf ? detail::uri_resolver(options.companions) : options.companions;
   detail::KeptRecord record;
   detail::KeptRecord* keep = options.keep_file ? &record : nullptr;
   detail::PolygonSoup soup;
@@ -214,12 +217,13 @@ LoadedMesh read_mesh_from_memory(std::string_view data, MeshFormat format, std::
       break;
     case MeshFormat::Gltf:
     case MeshFormat::Glb:
-      soup = detail::parse_gltf(data, format, n, options.companions, keep);
+      soup = detail::parse_gltf(data, format, n, companions, keep);
       break;
   }
   if (keep) {
     record.attributes.corners = soup.indices;
     record.attributes.offsets = soup.offsets;
+    if (format == MeshFormat::Obj) detail::read_obj_materials(record, options.companions);
   }
   LoadedMesh out = detail::build_mesh(std::move(soup), n);
   if (keep) {
@@ -228,9 +232,8 @@ LoadedMesh read_mesh_from_memory(std::string_view data, MeshFormat format, std::
     file->name = n;
     file->rest = out.info.file_vertices;
     file->attributes = std::move(record.attributes);
-    file->companions = options.companions;
+    file->companions = companions;
     file->layout = std::make_shared<const detail::FileLayout>(std::move(record.layout));
-    if (format == MeshFormat::Obj) detail::read_obj_materials(*file);
     out.file = std::move(file);
   }
   return out;

@@ -1,16 +1,13 @@
 #include "specdeform/mesh/mesh_file.h"
 
-#include <tiny_gltf.h>
-
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
 
-#include <nlohmann/json.hpp>
-
 #include "file_layout.h"
 #include "file_normals.h"
+#include "formats/gltf/data_uri.h"
 #include "mesh_writers.h"
 #include "specdeform/atomic_file.h"
 #include "specdeform/exceptions.h"
@@ -146,15 +143,7 @@ FileSummary MeshFile::summary() const {
           s.format += l.ascii ? " (ascii)" : " (binary)";
           s.round_trip = "everything; positions and facet normals rewritten";
         } else if constexpr (std::is_same_v<L, detail::GltfLayout>) {
-          s.meshes = l.meshes;
-          s.primitives = static_cast<int>(l.primitives.size());
-          s.skins = l.skins;
-          s.animations = l.animations;
-          s.morph_targets = l.morph_targets;
-          s.images = l.images;
-          s.uv_sets = l.uv_sets;
-          s.round_trip =
-              "everything; POSITION (with its min and max), NORMAL and TANGENT rewritten";
+          detail::summarize_gltf(l, s);
         }
       },
       layout->format);
@@ -164,31 +153,14 @@ FileSummary MeshFile::summary() const {
 std::optional<std::pair<std::string, std::string>> MeshFile::texture(int material) const {
   if (material < 0 || material >= int(attributes.materials.size())) return std::nullopt;
   const Material& m = attributes.materials[material];
-  const auto* gltf = std::get_if<detail::GltfLayout>(&layout->format);
-  if (gltf && m.gltf_image >= 0) {
-    try {
-      const nlohmann::json json = nlohmann::json::parse(gltf->json);
-      const nlohmann::json& image = json.at("images").at(m.gltf_image);
-      if (image.contains("bufferView")) {
-        const nlohmann::json& view = json.at("bufferViews").at(image.at("bufferView").get<int>());
-        const size_t buffer = view.value("buffer", 0), offset = view.value("byteOffset", 0),
-                     length = view.value("byteLength", 0);
-        if (buffer >= gltf->buffers.size()) return std::nullopt;
-        const std::string& bytes = gltf->buffers[buffer].bytes;
-        if (offset > bytes.size() || length > bytes.size() - offset) return std::nullopt;
-        return std::pair{bytes.substr(offset, length), image.value("mimeType", "")};
-      }
-    } catch (const nlohmann::json::exception&) {
-      return std::nullopt;
-    }
-    if (tinygltf::IsDataURI(m.texture)) {
-      std::vector<unsigned char> data;
-      std::string type;
-      if (!tinygltf::DecodeDataURI(&data, type, m.texture, 0, false)) return std::nullopt;
-      return std::pair{std::string(data.begin(), data.end()), type};
+  if (const auto* gltf = std::get_if<detail::GltfLayout>(&layout->format);
+      gltf && m.gltf_image >= 0) {
+    if (std::optional<std::pair<std::string, std::string>> image =
+            detail::gltf_image(gltf->doc, m.gltf_image)) {
+      return image;
     }
   }
-  if (m.texture.empty() || !companions) return std::nullopt;
+  if (m.texture.empty() || detail::is_data_uri(m.texture) || !companions) return std::nullopt;
   try {
     if (std::optional<std::string> bytes = companions(m.texture)) {
       return std::pair{std::move(*bytes), mime_type(m.texture)};
@@ -223,18 +195,23 @@ std::vector<std::string> companion_names(const MeshFile& file) {
   std::vector<std::string> names;
   std::set<std::string> seen;
   const auto add = [&](const std::string& name) {
-    if (!name.empty() && !tinygltf::IsDataURI(name) && seen.insert(name).second) {
+    if (!name.empty() && !detail::is_data_uri(name) && seen.insert(name).second) {
       names.push_back(name);
     }
   };
-  if (const auto* obj = std::get_if<detail::ObjLayout>(&file.layout->format)) {
-    for (const std::string& library : obj->mtllib) add(library);
-  }
-  if (const auto* gltf = std::get_if<detail::GltfLayout>(&file.layout->format)) {
-    for (const detail::GltfBuffer& b : gltf->buffers)
-      if (b.source == detail::GltfBufferSource::External) add(b.uri);
-  }
-  for (const Material& m : file.attributes.materials) add(m.texture);
+  std::visit(
+      [&](const auto& l) {
+        using L = std::decay_t<decltype(l)>;
+        if constexpr (std::is_same_v<L, detail::ObjLayout>) {
+          for (const std::string& library : l.mtllib) add(library);
+          for (const std::string& texture : l.textures) add(texture);
+        } else if constexpr (std::is_same_v<L, detail::PlyLayout>) {
+          for (const std::string& texture : l.textures) add(texture);
+        } else if constexpr (std::is_same_v<L, detail::GltfLayout>) {
+          for (const std::string& name : detail::gltf_companions(l.doc)) add(name);
+        }
+      },
+      file.layout->format);
   return names;
 }
 
@@ -252,7 +229,10 @@ EncodedMesh encode_mesh_file(const MeshFile& file, const Vertices& positions,
   const Eigen::MatrixX3d normals =
       a.normals.rows() > 0 ? detail::updated_normals(a, file.rest, positions, options.normals)
                            : Eigen::MatrixX3d();
-  if (format != file.format) return detail::encode_converted(file, positions, normals, out_name);
+  const auto is_gltf = [](MeshFormat f) { return f == MeshFormat::Gltf || f == MeshFormat::Glb; };
+  if (format != file.format && !(is_gltf(format) && is_gltf(file.format))) {
+    return detail::encode_converted(file, positions, normals, out_name);
+  }
   EncodedMesh out;
   if (normals.rows() > 0) {
     const detail::SharedNormals shared = detail::shared_normals(a, file.rest, positions, normals);
@@ -285,17 +265,23 @@ EncodedMesh encode_mesh_file(const MeshFile& file, const Vertices& positions,
       break;
     case MeshFormat::Gltf:
     case MeshFormat::Glb: {
+      // A changed buffer never takes the name of a file of the input's in its folder.
+      std::set<std::string> taken;
       std::error_code ec;
       const std::filesystem::path input(file.name);
-      const bool same_folder = std::filesystem::equivalent(
-          input.parent_path().empty() ? "." : input.parent_path(),
-          out_name.parent_path().empty() ? "." : out_name.parent_path(), ec);
-      EncodedMesh gltf =
-          detail::rewrite_gltf(file, positions, normals, out_name, same_folder || ec);
+      if (std::filesystem::equivalent(input.parent_path().empty() ? "." : input.parent_path(),
+                                      out_name.parent_path().empty() ? "." : out_name.parent_path(),
+                                      ec) ||
+          ec) {
+        taken.insert(input.filename().string());
+        for (const std::string& name : companion_names(file)) taken.insert(name);
+      }
+      EncodedMesh gltf = detail::rewrite_gltf(file, positions, normals, out_name, taken);
       gltf.notes.insert(gltf.notes.begin(), out.notes.begin(), out.notes.end());
       return gltf;
     }
   }
+  out.companions = companion_names(file);
   return out;
 }
 
@@ -315,10 +301,11 @@ std::vector<std::string> write_mesh_file(const std::filesystem::path& path, cons
       !file.companions) {
     return std::move(encoded.notes);
   }
-  std::set<std::string> written;
-  for (const OutputFile& f : encoded.files) written.insert(f.name);
-  for (const std::string& name : companion_names(file)) {
-    if (written.count(name) || leaves_folder(name)) continue;
+  for (const std::string& name : encoded.companions) {
+    if (leaves_folder(name)) {
+      encoded.notes.push_back(name + ", which the output names, is outside its folder: not copied");
+      continue;
+    }
     const std::filesystem::path target = folder / name;
     if (std::filesystem::exists(target, ec)) {
       const std::optional<std::string> there = read_file(target);

@@ -110,6 +110,7 @@ EncodedMesh encode_converted(const MeshFile& file, const Vertices& positions,
   out.files.push_back({out_name.filename().string(), {}});
   for (const std::string& p : e.parts) out.files.front().bytes += p;
   for (OutputFile& f : e.companions) out.files.push_back(std::move(f));
+  out.companions = std::move(e.kept);
   out.notes = std::move(e.notes);
   return out;
 }

@@ -245,4 +245,8 @@ ManifoldHarmonics compute_manifold_harmonics(const TriangleMesh& mesh,
   return h;
 }
 
+int default_modes(int vertices) {
+  return std::max(1, std::min(ManifoldHarmonicsOptions{}.num_modes, vertices - 1));
+}
+
 }  // namespace specdeform

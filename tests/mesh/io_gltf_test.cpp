@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -147,6 +148,22 @@ struct TestScene {
     return out.str();
   }
 };
+
+std::string read_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// A .glb of `json` and `bin`.
+std::string glb_of(const Json& json, std::string bin) {
+  std::string text = json.dump();
+  text.resize((text.size() + 3) / 4 * 4, ' ');
+  bin.resize((bin.size() + 3) / 4 * 4, '\0');
+  const auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  return "glTF" + u32(2) + u32(uint32_t(28 + text.size() + bin.size())) +
+         u32(uint32_t(text.size())) + "JSON" + text + u32(uint32_t(bin.size())) +
+         std::string("BIN\0", 4) + bin;
+}
 
 LoadedMesh keep(const std::string& bytes, MeshFormat format, FileResolver companions = {}) {
   return read_mesh_from_memory(bytes, format, "test",
@@ -315,36 +332,47 @@ TEST(Gltf, SeamsStayClosed) {
     EXPECT_LT((back.file->rest.row(v) - V.row(m.info.file_to_vertex[v])).norm(), 1e-5);
 }
 
-// A .gltf with its buffer beside it: the buffer is written under the output's name when the
-// output is beside the input, and found through the companions.
+// A .gltf with its buffer beside it: a changed buffer is written under the output's name, so
+// that two outputs in one folder stay apart and the input's own buffer is never replaced; an
+// unchanged one stays the input's, copied beside an output in another folder.
 TEST(Gltf, ExternalBuffer) {
   const auto dir = std::filesystem::temp_directory_path() / "specdeform_gltf_test";
   std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  std::filesystem::create_directories(dir / "out");
   TestScene scene;
   scene.model.buffers[0].uri = "scene data.bin";
   tinygltf::TinyGLTF writer;
   ASSERT_TRUE(writer.WriteGltfSceneToFile(&scene.model, (dir / "scene.gltf").string(), false, false,
                                           true, false));
-  ASSERT_TRUE(std::filesystem::exists(dir / "scene data.bin"));
+  const std::string input_buffer = read_bytes(dir / "scene data.bin");
   const LoadedMesh m = read_mesh(dir / "scene.gltf", {.keep_file = true, .companions = {}});
   EXPECT_EQ(m.info.file_vertices.rows(), 27);
   const EncodedMesh same = encode_mesh_file(*m.file, m.file->rest, dir / "copy.gltf");
   ASSERT_EQ(same.files.size(), 1u);  // nothing moved: the buffer is the input's
-  const Vertices X = m.file->rest.array() + 1.0;
-  write_mesh_file(dir / "moved.gltf", *m.file, X);
-  const Json json = Json::parse(std::ifstream(dir / "moved.gltf"));
-  EXPECT_EQ(json["buffers"][0]["uri"], "moved.bin");
-  EXPECT_LT((read_mesh(dir / "moved.gltf", {.keep_file = true, .companions = {}}).file->rest - X)
-                .cwiseAbs()
-                .maxCoeff(),
-            1e-5);
-  // Into another folder: under its own name there.
-  std::filesystem::create_directories(dir / "out");
+  EXPECT_EQ(same.companions, std::vector<std::string>{"scene data.bin"});
+  const Vertices X = m.file->rest.array() + 1.0, Y = m.file->rest.array() * 2.0;
+  write_mesh_file(dir / "a.gltf", *m.file, X);
+  write_mesh_file(dir / "b.gltf", *m.file, Y);
+  for (const auto& [name, positions] : {std::pair{"a", &X}, std::pair{"b", &Y}}) {
+    const auto path = dir / (std::string(name) + ".gltf");
+    EXPECT_EQ(Json::parse(std::ifstream(path))["buffers"][0]["uri"], std::string(name) + ".bin");
+    EXPECT_LT((read_mesh(path, {.keep_file = true, .companions = {}}).file->rest - *positions)
+                  .cwiseAbs()
+                  .maxCoeff(),
+              1e-5);
+  }
+  EXPECT_EQ(read_bytes(dir / "scene data.bin"), input_buffer);
+  // An output named after the input's buffer does not take its name.
+  write_mesh_file(dir / "scene data.gltf", *m.file, X);
+  EXPECT_EQ(Json::parse(std::ifstream(dir / "scene data.gltf"))["buffers"][0]["uri"],
+            "scene%20data-1.bin");
+  EXPECT_EQ(read_bytes(dir / "scene data.bin"), input_buffer);
+  // Into another folder: the changed buffer after the output, the unchanged one copied.
   write_mesh_file(dir / "out" / "moved.gltf", *m.file, X);
-  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "scene data.bin"));
   EXPECT_EQ(Json::parse(std::ifstream(dir / "out" / "moved.gltf"))["buffers"][0]["uri"],
-            "scene data.bin");
+            "moved.bin");
+  write_mesh_file(dir / "out" / "copy.gltf", *m.file, m.file->rest);
+  EXPECT_EQ(read_bytes(dir / "out" / "scene data.bin"), input_buffer);
   // Without it: one clear error.
   std::filesystem::remove(dir / "scene data.bin");
   try {
@@ -356,12 +384,9 @@ TEST(Gltf, ExternalBuffer) {
   std::filesystem::remove_all(dir);
 }
 
-void expect_refused(const tinygltf::Model& model, const std::string& fragment) {
-  std::ostringstream out;
-  tinygltf::TinyGLTF writer;
-  ASSERT_TRUE(writer.WriteGltfSceneToStream(&model, out, false, true));
+void expect_refused(const std::string& glb, const std::string& fragment) {
   try {
-    read_mesh_from_memory(out.str(), MeshFormat::Glb, "t.glb");
+    read_mesh_from_memory(glb, MeshFormat::Glb, "t.glb");
     ADD_FAILURE() << "no error, expected '" << fragment << "'";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
@@ -369,40 +394,257 @@ void expect_refused(const tinygltf::Model& model, const std::string& fragment) {
   }
 }
 
-TEST(Gltf, WhatCannotBeRewrittenIsRefused) {
-  {
-    TestScene s;
-    s.model.extensionsRequired = {"KHR_draco_mesh_compression"};
-    expect_refused(s.model, "KHR_draco_mesh_compression");
-  }
-  {
-    TestScene s;
-    s.model.accessors[0].sparse.isSparse = true;
-    s.model.accessors[0].sparse.count = 1;
-    expect_refused(s.model, "sparse");
-  }
-  {
-    TestScene s;  // quantised: the triangle's positions as shorts
-    const int view = s.view(std::vector<int16_t>{0, 0, 0, 1, 0, 0, 0, 1, 0, 0});
-    s.model.meshes[1].primitives[0].attributes["POSITION"] =
-        s.accessor(view, 0, 3, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_SHORT);
-    expect_refused(s.model, "quantised");
-  }
-  {
-    TestScene s;
-    s.model.nodes[2].mesh = 0;  // the cube drawn twice
-    expect_refused(s.model, "drawn by two nodes");
-  }
+TEST(Gltf, MalformedIsRefused) {
   {
     TestScene s;
     s.model.accessors[5].count = 1000;  // beyond its buffer
-    expect_refused(s.model, "beyond its buffer");
+    expect_refused(s.glb(), "beyond its buffer");
+  }
+  {
+    TestScene s;  // the node's mesh is a string: a member of the wrong type
+    Json json = chunks(s.glb()).first;
+    json["nodes"][1]["mesh"] = "cube";
+    expect_refused(glb_of(json, chunks(s.glb()).second), "names a missing mesh");
+    json["nodes"][1]["mesh"] = 0;
+    json["meshes"][0]["primitives"][0]["mode"] = "triangles";
+    expect_refused(glb_of(json, chunks(s.glb()).second), "malformed glTF");
+    json["meshes"][0]["primitives"][0].erase("mode");
+    json["nodes"][0]["children"] = {1, 1};
+    expect_refused(glb_of(json, chunks(s.glb()).second), "reached twice");
   }
   for (const std::string& bad : {std::string("glTF"), std::string("glTF\x02\0\0\0\xff\xff\0\0", 12),
                                  std::string("{\"asset\": {\"version\": \"2.0\"}}")}) {
     EXPECT_THROW(read_mesh_from_memory(bad, MeshFormat::Glb, "t.glb"), InputError);
     EXPECT_THROW(read_mesh_from_memory(bad, MeshFormat::Gltf, "t.gltf"), InputError);
   }
+}
+
+// The world positions of the mesh drawings of a kept file, keyed by (mesh, node): the drawings'
+// file vertices in order, whatever the file's numbering.
+std::map<std::pair<std::string, int>, Vertices> drawings(const LoadedMesh& m, const Json& json) {
+  std::map<std::pair<std::string, int>, Vertices> out;
+  int at = 0;
+  std::vector<std::pair<int, int>> order;  // mesh, node
+  for (size_t n = 0; n < json["nodes"].size(); ++n)
+    if (json["nodes"][n].contains("mesh")) order.emplace_back(json["nodes"][n]["mesh"], int(n));
+  std::sort(order.begin(), order.end());
+  for (const auto& [mesh, node] : order) {
+    int count = 0;
+    for (const Json& p : json["meshes"][mesh]["primitives"])
+      if (p.value("mode", 4) >= 4)
+        count += int(json["accessors"][int(p["attributes"]["POSITION"])]["count"]);
+    out[{json["meshes"][mesh].value("name", ""), node}] = m.file->rest.middleRows(at, count);
+    at += count;
+  }
+  return out;
+}
+
+// The cube drawn by a second node: a drawing of its own, numbered after the first; moving one
+// drawing gives it its own POSITION (a new mesh for its node), the other keeps its bytes; moving
+// both alike in the cube's own space keeps one accessor.
+TEST(Gltf, MeshDrawnByTwoNodes) {
+  TestScene scene;
+  tinygltf::Node twin;
+  twin.mesh = 0;
+  twin.translation = {10, 0, 0};
+  scene.model.nodes.push_back(twin);
+  scene.model.scenes[0].nodes.push_back(3);
+  const std::string glb = scene.glb();
+  const LoadedMesh m = keep(glb, MeshFormat::Glb);
+  ASSERT_EQ(m.info.file_vertices.rows(), 24 + 24 + 3);
+  const Eigen::Matrix4d world = cube_world();
+  for (int v = 0; v < 24; ++v) {
+    const Eigen::Vector4d local =
+        world.inverse() *
+        Eigen::Vector4d(m.file->rest(v, 0), m.file->rest(v, 1), m.file->rest(v, 2), 1);
+    EXPECT_LT((m.file->rest.row(24 + v).transpose() - (local.head<3>() + Eigen::Vector3d(10, 0, 0)))
+                  .norm(),
+              1e-12);
+  }
+  EXPECT_EQ(m.mesh.num_vertices(), 8 + 8 + 3);  // two pieces, welded apart
+  EXPECT_EQ(encode_mesh_file(*m.file, m.file->rest, "o.glb").files[0].bytes, glb);
+  EXPECT_EQ(m.file->summary().drawings, 3);
+
+  // The twin moved.
+  Vertices X = m.file->rest;
+  X.middleRows(24, 24).rowwise() += Eigen::RowVector3d(0, 0, 3);
+  const EncodedMesh moved = encode_mesh_file(*m.file, X, "o.glb");
+  const auto [json, bin] = chunks(moved.files[0].bytes);
+  ASSERT_EQ(json["meshes"].size(), 4u);
+  EXPECT_EQ(json["nodes"][1]["mesh"], 0);
+  EXPECT_EQ(json["nodes"][3]["mesh"], 3);
+  const Json& copy = json["meshes"][3]["primitives"][0]["attributes"];
+  EXPECT_NE(copy["POSITION"], 0);
+  EXPECT_EQ(copy["NORMAL"], 1);  // a translation turns no normal: still shared
+  EXPECT_EQ(copy["TEXCOORD_0"], 2);
+  EXPECT_EQ(json["meshes"][3]["primitives"][0]["indices"], 4);
+  EXPECT_EQ(bin.substr(0, chunks(glb).second.size()), chunks(glb).second);  // the input's bytes
+  ASSERT_EQ(moved.notes.size(), 1u);
+  EXPECT_NE(moved.notes[0].find("1 meshes copied"), std::string::npos) << moved.notes[0];
+  const LoadedMesh back = keep(moved.files[0].bytes, MeshFormat::Glb);
+  const auto before = drawings(m, chunks(glb).first), after = drawings(back, json);
+  EXPECT_LT((after.at({"cube", 1}) - before.at({"cube", 1})).cwiseAbs().maxCoeff(), 0.0 + 1e-300);
+  EXPECT_LT((after.at({"cube", 3}) - X.middleRows(24, 24)).cwiseAbs().maxCoeff(), 1e-5);
+  const Json& position = json["accessors"][int(copy["POSITION"])];
+  EXPECT_EQ(position["count"], 24);
+  EXPECT_EQ(position["min"], Json({-1.0, -1.0, 2.0}));  // the twin's node only translates
+
+  // Both moved alike in the cube's space: the accessor is rewritten in place, still shared.
+  Vertices Y = m.file->rest;
+  for (int v = 0; v < 48; ++v) {
+    const Eigen::Matrix4d w =
+        v < 24 ? world : Eigen::Affine3d(Eigen::Translation3d(10, 0, 0)).matrix();
+    const Eigen::Vector4d local = w.inverse() * Eigen::Vector4d(Y(v, 0), Y(v, 1), Y(v, 2), 1);
+    Y.row(v) =
+        (w * Eigen::Vector4d(local.x() * 1.5, local.y(), local.z(), 1)).head<3>().transpose();
+  }
+  const auto [json_y, bin_y] = chunks(encode_mesh_file(*m.file, Y, "o.glb").files[0].bytes);
+  EXPECT_EQ(json_y["meshes"].size(), 3u);
+  EXPECT_EQ(json_y["accessors"].size(), chunks(glb).first["accessors"].size());
+  EXPECT_EQ(json_y["accessors"][0]["max"][0], 1.5);
+}
+
+// An accessor two meshes share, drawn at two places: each drawing its own when they differ.
+TEST(Gltf, AccessorSharedByTwoMeshes) {
+  TestScene scene;  // mesh 2 is mesh 1 (the triangle) again, with the same accessor
+  tinygltf::Node node;
+  node.mesh = 2;
+  node.translation = {0, 0, 5};
+  scene.model.nodes.push_back(node);
+  scene.model.scenes[0].nodes.push_back(3);
+  const LoadedMesh m = keep(scene.glb(), MeshFormat::Glb);
+  ASSERT_EQ(m.info.file_vertices.rows(), 24 + 3 + 3);
+  Vertices X = m.file->rest;
+  X.bottomRows(3).col(1).array() += 1.0;  // mesh 2's drawing
+  const auto [json, bin] = chunks(encode_mesh_file(*m.file, X, "o.glb").files[0].bytes);
+  const int original =
+      chunks(scene.glb()).first["meshes"][1]["primitives"][0]["attributes"]["POSITION"];
+  EXPECT_EQ(json["meshes"][1]["primitives"][0]["attributes"]["POSITION"], original);
+  EXPECT_NE(json["meshes"][2]["primitives"][0]["attributes"]["POSITION"], original);
+  EXPECT_EQ(json["meshes"].size(), 3u);  // mesh 2 has one node: re-pointed where it stands
+  const LoadedMesh back =
+      keep(encode_mesh_file(*m.file, X, "o.glb").files[0].bytes, MeshFormat::Glb);
+  EXPECT_LT((back.file->rest - X).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+// Positions stored as shorts (KHR_mesh_quantization) or sparse: read, and written as a float
+// accessor of their own; every accessor written has the min and max of its values.
+TEST(Gltf, QuantisedAndSparsePositions) {
+  TestScene scene;
+  const int view = scene.view(std::vector<int16_t>{0, 0, 0, 2, 0, 0, 0, 2, 0, 0});
+  scene.model.meshes[1].primitives[0].attributes["POSITION"] =
+      scene.accessor(view, 0, 3, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_SHORT);
+  scene.model.accessors.back().minValues = {0, 0, 0};
+  scene.model.accessors.back().maxValues = {2, 2, 0};
+  scene.model.extensionsUsed = {"KHR_mesh_quantization"};
+  scene.model.extensionsRequired = {"KHR_mesh_quantization"};
+  // The cube's normals with a min and max, as exporters write them.
+  scene.model.accessors[1].minValues = {-1, -1, -1};
+  scene.model.accessors[1].maxValues = {1, 1, 1};
+  const LoadedMesh m = keep(scene.glb(), MeshFormat::Glb);
+  EXPECT_EQ(m.file->rest.row(25), Eigen::RowVector3d(5 - 2, 0, 0));  // mirrored by its node
+  Eigen::Affine3d turn(Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()));
+  const Vertices X = m.file->rest * turn.linear().transpose();
+  const auto [json, bin] = chunks(encode_mesh_file(*m.file, X, "o.glb").files[0].bytes);
+  const int position = json["meshes"][1]["primitives"][0]["attributes"]["POSITION"];
+  EXPECT_EQ(json["accessors"][position]["componentType"], TINYGLTF_COMPONENT_TYPE_FLOAT);
+  EXPECT_FALSE(json["accessors"][position].contains("normalized"));
+  EXPECT_EQ(json["extensionsRequired"], Json({"KHR_mesh_quantization"}));
+  const LoadedMesh back = keep(glb_of(json, bin), MeshFormat::Glb);
+  EXPECT_LT((back.file->rest - X).cwiseAbs().maxCoeff(), 1e-5);
+  // The turned normals' min and max are their own.
+  const Json& normal = json["accessors"][1];
+  for (int k = 0; k < 3; ++k) {
+    float lo = INFINITY, hi = -INFINITY;
+    for (int v = 0; v < 24; ++v) {
+      float n[3];
+      std::memcpy(n, bin.data() + 24 * v + 12, 12);
+      lo = std::min(lo, n[k]);
+      hi = std::max(hi, n[k]);
+    }
+    EXPECT_EQ(normal["min"][k].get<float>(), lo);
+    EXPECT_EQ(normal["max"][k].get<float>(), hi);
+  }
+
+  // Sparse: the triangle's positions all zero but one vertex.
+  TestScene sparse;
+  tinygltf::Accessor& a = sparse.model.accessors[5];
+  a.bufferView = -1;
+  a.sparse.isSparse = true;
+  a.sparse.count = 1;
+  a.sparse.indices.bufferView = sparse.view(std::vector<uint16_t>{2, 0});
+  a.sparse.indices.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+  a.sparse.indices.byteOffset = 0;
+  a.sparse.values.bufferView = sparse.view(std::vector<float>{0, 3, 0});
+  a.sparse.values.byteOffset = 0;
+  const LoadedMesh s = keep(sparse.glb(), MeshFormat::Glb);
+  EXPECT_EQ(s.file->rest.row(26), Eigen::RowVector3d(5, 3, 0));
+  const Vertices Z = s.file->rest.array() + 0.5;
+  const LoadedMesh s_back =
+      keep(encode_mesh_file(*s.file, Z, "o.glb").files[0].bytes, MeshFormat::Glb);
+  EXPECT_LT((s_back.file->rest - Z).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+// A node drawing the triangle by EXT_mesh_gpu_instancing: one drawing per instance; kept where
+// the instances stay alike, one child node per instance where they do not.
+TEST(Gltf, GpuInstancing) {
+  TestScene scene;
+  const int t = scene.accessor(scene.view(std::vector<float>{0, 0, 0, 0, 3, 0, 0, 6, 0}), 0, 3,
+                               TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT);
+  auto [json, bin] = chunks(scene.glb());
+  json["nodes"][2]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["TRANSLATION"] = t;
+  json["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
+  const std::string glb = glb_of(json, bin);
+  const LoadedMesh m = keep(glb, MeshFormat::Glb);
+  ASSERT_EQ(m.info.file_vertices.rows(), 24 + 9);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_EQ(m.file->rest.row(24 + 3 * i), Eigen::RowVector3d(5, 3.0 * i, 0));
+  EXPECT_EQ(encode_mesh_file(*m.file, m.file->rest, "o.glb").files[0].bytes, glb);
+  Vertices X = m.file->rest;
+  X.row(24 + 3).x() += 1;  // instance 1's first corner
+  const EncodedMesh moved = encode_mesh_file(*m.file, X, "o.glb");
+  const Json out = chunks(moved.files[0].bytes).first;
+  EXPECT_FALSE(out.contains("extensionsUsed"));
+  EXPECT_FALSE(out["nodes"][2].contains("mesh"));
+  ASSERT_EQ(out["nodes"][2]["children"], Json({3, 4, 5}));
+  EXPECT_EQ(out["nodes"][3]["mesh"], out["nodes"][5]["mesh"]);
+  EXPECT_NE(out["nodes"][3]["mesh"], out["nodes"][4]["mesh"]);
+  EXPECT_EQ(out["nodes"][4]["translation"], Json({0.0, 3.0, 0.0}));
+  const LoadedMesh back = keep(moved.files[0].bytes, MeshFormat::Glb);
+  EXPECT_EQ(back.info.file_vertices.rows(), 33);
+}
+
+// .glb <-> .gltf: the same document, only where the bytes live changes.
+TEST(Gltf, ContainerChangeKeepsTheDocument) {
+  TestScene scene;
+  scene.model.nodes[1].name = "cube node";
+  tinygltf::Material material;
+  material.name = "glow";
+  material.emissiveFactor = {1, 0.5, 0};
+  material.extensions["KHR_materials_unlit"] = tinygltf::Value(tinygltf::Value::Object());
+  scene.model.materials.push_back(material);
+  scene.model.meshes[0].primitives[0].material = 0;
+  scene.model.extensionsUsed = {"KHR_materials_unlit"};
+  const std::string glb = scene.glb();
+  const LoadedMesh m = keep(glb, MeshFormat::Glb);
+  const Vertices X = m.file->rest.array() * 1.25;
+  const EncodedMesh gltf = encode_mesh_file(*m.file, X, "dir/out.gltf");
+  ASSERT_EQ(gltf.files.size(), 2u);
+  EXPECT_EQ(gltf.files[1].name, "out.bin");
+  Json text = Json::parse(gltf.files[0].bytes);
+  EXPECT_EQ(text["buffers"][0]["uri"], "out.bin");
+  Json expected = chunks(encode_mesh_file(*m.file, X, "o.glb").files[0].bytes).first;
+  text["buffers"][0].erase("uri");
+  EXPECT_EQ(text, expected);  // nodes, names, materials, extensions, extras: all there
+  // And back into a .glb: the buffer file and the embedded image in the BIN chunk.
+  const LoadedMesh g = keep(gltf.files[0].bytes, MeshFormat::Gltf, [&](const std::string& name) {
+    return name == "out.bin" ? std::optional(gltf.files[1].bytes) : std::nullopt;
+  });
+  const EncodedMesh again = encode_mesh_file(*g.file, g.file->rest, "again.glb");
+  ASSERT_EQ(again.files.size(), 1u);
+  EXPECT_EQ(chunks(again.files[0].bytes).first, expected);
+  EXPECT_LT((keep(again.files[0].bytes, MeshFormat::Glb).file->rest - X).cwiseAbs().maxCoeff(),
+            1e-5);
 }
 
 }  // namespace

@@ -58,7 +58,8 @@ Eigen::VectorXd piece_area_fractions(const Eigen::VectorXd& vertex_area,
 // Target position of every constrained vertex (|C| x 3): the group's transform applied to
 // `positions` (fixed vertices keep theirs). Throws InputError for a wrong number of transforms,
 // a non-finite, singular or mirroring (negative determinant) transform, or a target more than a
-// million times the constrained region's size from its vertex.
+// million times the constrained region's size (the mesh's, for a region of one vertex) from its
+// vertex.
 Eigen::MatrixX3d constraint_targets(const ConstrainedSet& set, const Eigen::MatrixX3d& positions,
                                     const std::vector<Eigen::Affine3d>& transforms);
 

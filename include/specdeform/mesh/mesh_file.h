@@ -97,9 +97,14 @@ struct FileSummary {
   bool vertex_colours = false;
   std::vector<std::string> materials;
   int groups = 0;  // OBJ g/o lines
-  int meshes = 0, primitives = 0, skins = 0, animations = 0, morph_targets = 0, images = 0;
+  // glTF: nodes; meshes drawn and their drawings (a mesh drawn by k nodes counts k); triangle
+  // primitives as drawn; skins, animations, morph targets, images; extensionsUsed.
+  int nodes = 0, meshes = 0, drawings = 0, primitives = 0, skins = 0, animations = 0,
+      morph_targets = 0, images = 0;
+  std::vector<std::string> extensions;
   std::vector<std::string> properties;  // PLY: "element.property (type)" beyond x y z
   std::string round_trip;               // what writing the same format keeps
+  std::vector<std::string> changes;     // what writing it changes beyond that (decompression)
 };
 
 struct MeshReadInfo;
@@ -148,9 +153,12 @@ struct OutputFile {
 };
 
 struct EncodedMesh {
-  std::vector<OutputFile> files;   // the mesh file first, then companions that changed (a glTF's
-                                   // external buffers)
-  std::vector<std::string> notes;  // what was dropped or changed beyond positions and normals
+  std::vector<OutputFile> files;  // the mesh file first, then the companions it wrote (a glTF's
+                                  // changed buffers, an MTL and images made for another format)
+  std::vector<std::string> companions;  // the files it names that stay as the input has them
+                                        // (names relative to both: MeshFile::companions reads
+                                        // them), to be beside it
+  std::vector<std::string> notes;       // what was dropped or changed beyond positions and normals
 };
 
 // The file with new `positions` (one row per file vertex), in the format of `out_name`'s
@@ -160,9 +168,9 @@ EncodedMesh encode_mesh_file(const MeshFile& file, const Vertices& positions,
                              const std::filesystem::path& out_name,
                              const WriteOptions& options = {});
 
-// encode_mesh_file() written atomically to `path`; the companions the file names that did not
-// change (an MTL and its textures, a glTF's images and other buffers) are copied beside it when
-// `path` is in another folder and no file of that name is there yet. Returns the notes.
+// encode_mesh_file() written atomically to `path`; the companions that did not change (an MTL
+// and its textures, a glTF's images and other buffers) are copied beside it when `path` is in
+// another folder and no file of that name is there yet. Returns the notes.
 std::vector<std::string> write_mesh_file(const std::filesystem::path& path, const MeshFile& file,
                                          const Vertices& positions,
                                          const WriteOptions& options = {});
@@ -176,8 +184,8 @@ std::vector<int> triangle_corners(const MeshFile& file, const MeshReadInfo& info
 // "3 skins", ...): what a mesh written from triangles alone (subdivide) leaves behind.
 std::vector<std::string> contents_beyond_triangles(const MeshFile& file);
 
-// The names, relative to the file's folder, of the companions it names (MTL files, textures,
-// glTF buffers and images), each once.
+// The names, relative to the file's folder, of the companions it names (MTL files and every
+// texture they name, glTF buffers and images, a PLY's TextureFile), each once.
 std::vector<std::string> companion_names(const MeshFile& file);
 
 }  // namespace specdeform

@@ -130,6 +130,11 @@ struct ManifoldHarmonicsOptions {
   void validate() const;  // throws InputError; num_modes is checked against the mesh later
 };
 
+// The default m for a mesh of `vertices` vertices: ManifoldHarmonicsOptions' num_modes, or one
+// fewer than the vertices where the mesh has no more (every eigensolver takes m < n). Front ends
+// that lower it so say it.
+int default_modes(int vertices);
+
 enum class SolveStatus { Converged, NotConverged };
 
 // A basis held as the multilevel solver makes it: H = P Z, P n x N sparse (rows summing to 1, a

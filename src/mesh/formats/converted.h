@@ -79,11 +79,12 @@ struct Target {
   std::string name, stem;
 };
 
-// A file in parts to be concatenated (a large one is written part by part), its companions and
-// what it dropped.
+// A file in parts to be concatenated (a large one is written part by part), the companions it
+// made, the files it names as they are (EncodedMesh::companions) and what it dropped.
 struct Encoded {
   std::vector<std::string> parts;
   std::vector<OutputFile> companions;
+  std::vector<std::string> kept;
   std::vector<std::string> notes;
 };
 

@@ -1,73 +1,75 @@
-// Internal: glTF 2.0 (.gltf, .glb; docs/files.md, "glTF"): read into a polygon soup
-// (gltf_reader.cpp), rewritten with new positions, normals and tangents (gltf_rewriter.cpp),
-// written afresh (gltf_writer.cpp).
+// Internal: glTF 2.0 (.gltf with its buffers in files or data URIs, .glb) read, rewritten and
+// written (docs/files.md, "glTF").
+//
+// parse_gltf: the triangle primitives (modes 4, 5, 6) of every drawing of the default scene
+// (gltf_scene.h), in world space: a mesh drawn by k nodes is k pieces; an accessor shared by
+// several primitives or meshes is read once per drawing. File vertices: drawing by drawing
+// (meshes in the `meshes` order, each mesh's drawings in node order), primitive by primitive,
+// POSITION element by element. Vertices at exactly the same world position are welded for the
+// solve (glTF splits them along UV seams and hard edges); a mirroring node's triangles are turned
+// to face outwards in world space. Draco and meshopt data are decoded and EXT_mesh_gpu_instancing
+// drawn instance by instance (gltf_decode.h); positions of any component type
+// (KHR_mesh_quantization) and sparse accessors are read.
+//
+// rewrite_gltf: the document with new positions (one row per file vertex, world space), normals
+// and tangents, in the container of `out_name` (.glb or .gltf), its changed buffers named after
+// it but never as one of `taken`: see gltf_rewriter.cpp.
+//
+// gltf_bytes: a mesh of another format as a new glTF (mesh_writers.h).
 #pragma once
 
 #include <filesystem>
+#include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
 
-#include "specdeform/mesh/mesh_file.h"
+#include "gltf_document.h"
 
 namespace specdeform::detail {
 
 struct PolygonSoup;
 struct KeptRecord;
 
-// A float accessor's elements in a buffer.
-struct GltfSlots {
-  int accessor = -1;
-  int buffer = 0;
-  size_t offset = 0;  // of element 0 in the buffer
-  size_t stride = 0;  // bytes from one element to the next
-  int count = 0;
-};
-
-// A triangle primitive's attributes as the writer rewrites them: file vertices first_vertex ..
-// first_vertex + position.count - 1 are its POSITION elements, and the same rows of the
-// FileAttributes' normals and GltfLayout::tangents its NORMAL and TANGENT elements.
-struct GltfPrimitive {
-  GltfSlots position, normal, tangent;  // accessor -1: absent
-  int first_vertex = 0;
+// A triangle primitive as one node draws it: file vertices first_vertex .. first_vertex + count
+// - 1 are its POSITION elements, and the same rows of FileAttributes::normals and
+// GltfLayout::tangents its NORMAL and TANGENT elements.
+struct GltfUnit {
+  int mesh = -1, primitive = -1, node = -1, instance = -1;
+  int first_vertex = 0, count = 0;
   Eigen::Matrix4d world = Eigen::Matrix4d::Identity();  // mesh space -> world space
-};
-
-enum class GltfContainer { Glb, Gltf };
-enum class GltfBufferSource { GlbChunk, DataUri, External };
-
-struct GltfBuffer {
-  GltfBufferSource source = GltfBufferSource::GlbChunk;
-  std::string uri;    // External and DataUri: as written in the JSON
-  std::string bytes;  // the buffer's contents, decoded
+  int position = -1, normal = -1, tangent = -1;         // accessors (-1: absent)
 };
 
 struct GltfLayout {
-  GltfContainer container = GltfContainer::Glb;
-  std::string json;  // the JSON as written (a .glb's JSON chunk, unpadded)
-  std::vector<GltfBuffer> buffers;
-  std::string glb_tail;   // a .glb's chunks after BIN, as they were
-  std::string glb_after;  // bytes after the length its header gives, as they were
-  std::vector<GltfPrimitive> primitives;
+  GltfDocument doc;  // as read, compressed data decoded
+  std::vector<GltfUnit> units;
   Eigen::MatrixX4d tangents;  // per file vertex, world space xyz and w (with NORMAL)
-  int meshes = 0, skins = 0, animations = 0, morph_targets = 0, images = 0, uv_sets = 0;
 };
 
 PolygonSoup parse_gltf(std::string_view data, MeshFormat format, const std::string& name,
                        const FileResolver& companions, KeptRecord* keep);
 
-// The .glb or .gltf, then the external buffers whose bytes changed, named as `out_name`'s
-// companions (the buffer's own uri where `out_name` is in another folder than the input, else
-// "<out stem>.bin", "<out stem>-1.bin", ...).
 EncodedMesh rewrite_gltf(const MeshFile& file, const Vertices& positions,
                          const Eigen::MatrixX3d& normals, const std::filesystem::path& out_name,
-                         bool same_folder);
+                         const std::set<std::string>& taken);
 
 // One mesh of one primitive per material: TEXCOORD_0 (v turned), NORMAL, COLOR_0, materials
 // with their base colour and image (embedded).
 std::string gltf_bytes(const FileAttributes& a, const Vertices& X, const Eigen::MatrixX3d& normals,
                        bool binary, const MeshFile* file);
+
+// What the file holds (MeshFile::summary's glTF part).
+void summarize_gltf(const GltfLayout& layout, FileSummary& s);
+
+// Image `image`'s bytes and MIME type, wherever it lives (a buffer view, a data URI); nullopt
+// for one in a file (read it through the companions) or out of range.
+std::optional<std::pair<std::string, std::string>> gltf_image(const GltfDocument& doc, int image);
+
+// The files the glTF names beside it: its external buffers and images (decoded uris).
+std::vector<std::string> gltf_companions(const GltfDocument& doc);
 
 }  // namespace specdeform::detail

@@ -1,46 +1,103 @@
 // The materials an OBJ's MTL files define (obj.h).
-#include "mesh/file_layout.h"
-#include "mesh/text_scanner.h"
+#include <charconv>
+#include <filesystem>
+
+#include "mesh/polygon_soup.h"
 #include "obj.h"
 #include "specdeform/exceptions.h"
 
 namespace specdeform::detail {
 
-// Kd and map_Kd of the materials the OBJ's MTL files define (texture names relative to the OBJ's
-// folder); a missing MTL leaves the materials plain.
-void read_obj_materials(MeshFile& file) {
-  const ObjLayout& layout = std::get<ObjLayout>(file.layout->format);
-  if (file.attributes.materials.empty() || !file.companions) return;
+namespace {
+
+std::string_view trimmed(std::string_view s) {
+  const size_t first = s.find_first_not_of(" \t\r");
+  if (first == std::string_view::npos) return {};
+  return s.substr(first, s.find_last_not_of(" \t\r") - first + 1);
+}
+
+// The first word of `s` and the rest after the blanks that follow it.
+std::pair<std::string_view, std::string_view> first_word(std::string_view s) {
+  const size_t end = std::min(s.find_first_of(" \t"), s.size());
+  return {s.substr(0, end), trimmed(s.substr(end))};
+}
+
+bool is_number(std::string_view t) {
+  double v;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  return ec == std::errc() && end == t.data() + t.size();
+}
+
+bool is_texture_statement(std::string_view key) {
+  return key.starts_with("map_") || key == "bump" || key == "disp" || key == "decal" ||
+         key == "refl" || key == "norm";
+}
+
+}  // namespace
+
+std::string mtl_texture_name(std::string_view rest) {
+  // Options with a fixed count of words, and -o, -s and -t with one to three numbers.
+  static constexpr std::pair<std::string_view, int> kOptions[] = {
+      {"-blendu", 1}, {"-blendv", 1},  {"-bm", 1}, {"-boost", 1},  {"-cc", 1},
+      {"-clamp", 1},  {"-imfchan", 1}, {"-mm", 2}, {"-texres", 1}, {"-type", 1},
+      {"-o", -3},     {"-s", -3},      {"-t", -3}};
+  rest = trimmed(rest);
+  for (;;) {
+    const auto [word, after] = first_word(rest);
+    const auto option = std::find_if(std::begin(kOptions), std::end(kOptions),
+                                     [&](const auto& o) { return o.first == word; });
+    if (option == std::end(kOptions)) break;
+    rest = after;
+    for (int k = 0; k < std::abs(option->second) && !rest.empty(); ++k) {
+      const auto [value, next] = first_word(rest);
+      if (option->second < 0 && !is_number(value)) break;  // -s u [v [w]]
+      rest = next;
+    }
+  }
+  std::string name(rest);
+  std::replace(name.begin(), name.end(), '\\', '/');  // written on Windows
+  return name;
+}
+
+void read_obj_materials(KeptRecord& record, const FileResolver& companions) {
+  ObjLayout& layout = std::get<ObjLayout>(record.layout.format);
+  std::vector<Material>& materials = record.attributes.materials;
+  if (!companions) return;
   for (const std::string& library : layout.mtllib) {
     std::optional<std::string> text;
     try {
-      text = file.companions(library);
+      text = companions(library);
     } catch (const InputError&) {
       continue;  // a name the resolver refuses: plain materials
     }
     if (!text) continue;
     const std::filesystem::path folder = std::filesystem::path(library).parent_path();
-    TextScanner in(*text, library);
     Material* current = nullptr;
-    for (std::string_view key = in.next(); !key.empty(); key = in.next()) {
+    for (size_t at = 0; at < text->size();) {
+      size_t end = text->find('\n', at);
+      if (end == std::string::npos) end = text->size();
+      const auto [key, rest] = first_word(trimmed(std::string_view(*text).substr(at, end - at)));
+      at = end + 1;
       if (key == "newmtl") {
-        const std::string name(in.next());
         current = nullptr;
-        for (Material& m : file.attributes.materials)
-          if (m.name == name) current = &m;
+        for (Material& m : materials)
+          if (m.name == rest) current = &m;
       } else if (current && key == "Kd") {
-        for (int k = 0; k < 3 && !in.at_line_end(); ++k) {
-          const std::string_view t = in.next();
+        std::string_view values = rest;
+        for (int k = 0; k < 3 && !values.empty(); ++k) {
+          const auto [t, next] = first_word(values);
           double v = 1;
           std::from_chars(t.data(), t.data() + t.size(), v);
           current->base_color[k] = static_cast<float>(v);
+          values = next;
         }
-      } else if (current && key == "map_Kd") {
-        std::string_view last;  // options (-s 1 1 1 ...) come first; the file name is last
-        while (!in.at_line_end()) last = in.next();
-        if (!last.empty()) current->texture = (folder / std::string(last)).generic_string();
+      } else if (is_texture_statement(key)) {
+        const std::string name = mtl_texture_name(rest);
+        if (name.empty()) continue;
+        const std::string path = (folder / name).lexically_normal().generic_string();
+        layout.textures.push_back(path);
+        if (current && key == "map_Kd") current->texture = path;
       }
-      in.skip_line();
     }
   }
 }

@@ -19,15 +19,22 @@ struct Target;
 // The first number of each `v` and `vn` line (just after the keyword); the vn lines in order.
 struct ObjLayout {
   std::vector<size_t> v, vn;
-  std::vector<std::string> mtllib;  // the MTL files named, in order
-  int groups = 0;                   // g and o lines
+  std::vector<std::string> mtllib;    // the MTL files named, in order
+  int groups = 0;                     // g and o lines
+  std::vector<std::string> textures;  // every image the MTL files name (relative to the OBJ)
 };
 
 PolygonSoup parse_obj(std::string_view data, const std::string& name, KeptRecord* keep);
 
-// An OBJ's materials completed from the MTL files it names (Kd, map_Kd), read through its
-// companions; those it cannot read stay plain.
-void read_obj_materials(MeshFile& file);
+// A kept OBJ's materials completed from the MTL files it names (Kd, map_Kd), read through
+// `companions`, and the images they name (every map_*, bump, disp, decal, refl, norm) in its
+// layout; materials it cannot read stay plain.
+void read_obj_materials(KeptRecord& record, const FileResolver& companions);
+
+// The file an MTL texture statement names, from the words after its keyword: the rest of the
+// line after the options (-s 1 1 1, -o, -bm 0.5, -clamp on, ...), spaces kept, backslashes as
+// slashes.
+std::string mtl_texture_name(std::string_view rest);
 
 // `positions`: one row per file vertex; `normals`: the updated rows of the file's normals
 // (FileAttributes::normals; file_normals.h), empty when it has none.

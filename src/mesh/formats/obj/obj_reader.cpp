@@ -254,7 +254,7 @@ void keep_record(ObjRecord&& r, std::string_view data, KeptRecord& keep) {
     a.polygon_material = std::move(r.material);
     for (int& m : a.polygon_material) m = std::max(m, -1);  // before any usemtl: none
   }
-  keep.layout.format = ObjLayout{std::move(r.v), std::move(r.vn), std::move(r.mtllib), r.groups};
+  keep.layout.format = ObjLayout{std::move(r.v), std::move(r.vn), std::move(r.mtllib), r.groups, {}};
 }
 
 }  // namespace
@@ -301,6 +301,9 @@ PolygonSoup parse_obj(std::string_view raw, const std::string& name, KeptRecord*
     TextScanner(data, name).fail("empty file (no vertices)");
   }
   if (keep) keep_record(std::move(first), data, *keep);
+  // Some exporters (trimesh, scanners) write a position once per texture coordinate or normal
+  // instead of indexing them apart: copies at one place are one vertex, or the seams open.
+  soup.weld = weld_coincident(soup.xyz);
   return soup;
 }
 

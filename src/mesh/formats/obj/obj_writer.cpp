@@ -31,6 +31,7 @@ Encoded encode_obj(const FileAttributes& a, const Vertices& X, const Eigen::Matr
         }
       }
       if (!texture.empty()) mtl += "map_Kd " + texture + "\n";
+      if (!texture.empty() && mat.gltf_image < 0) out.kept.push_back(texture);
     }
     out.companions.push_back({target.stem + ".mtl", std::move(mtl)});
     parts.push_back("mtllib " + target.stem + ".mtl\n");

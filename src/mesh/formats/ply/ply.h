@@ -39,6 +39,7 @@ struct PlyLayout {
   int xyz[3] = {-1, -1, -1};
   int normal[3] = {-1, -1, -1};
   std::vector<size_t> vertex;
+  std::vector<std::string> textures;  // the images its `comment TextureFile` lines name
 };
 
 PolygonSoup parse_ply(std::string_view data, const std::string& name, KeptRecord* keep);

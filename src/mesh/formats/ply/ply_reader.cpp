@@ -123,6 +123,7 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name, KeptRecord
   BodyReader::Encoding enc = BodyReader::Encoding::Ascii;
   bool have_format = false;
   std::vector<Element> elements;
+  std::vector<std::string> textures;
   for (std::string_view key = header.next(false); !key.empty(); key = header.next(false)) {
     if (key == "format") {
       const std::string_view f = header.next(false);
@@ -155,6 +156,15 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name, KeptRecord
       if (!parse_scalar(t, p.type)) header.fail("unknown property type '" + std::string(t) + "'");
       p.name = std::string(header.next(false));
       elements.back().properties.push_back(std::move(p));
+    } else if (key == "comment" && header.next(false) == "TextureFile") {
+      // MeshLab names the image of its texcoord lists so; the name may hold spaces.
+      const size_t start = header.position();
+      size_t end = std::min(data.find('\n', start), header_end);
+      std::string_view line = data.substr(start, end - start);
+      while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
+      while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.remove_suffix(1);
+      if (!line.empty()) textures.emplace_back(line);
+      header.skip_line();
     } else {  // comment, obj_info and unknown keywords
       header.skip_line();
     }
@@ -214,6 +224,7 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name, KeptRecord
   FileAttributes* a = keep ? &keep->attributes : nullptr;
   if (keep) {
     layout.encoding = enc;
+    layout.textures = std::move(textures);
     layout.vertex_element = static_cast<int>(vertex - elements.data());
     for (int k = 0; k < 3; ++k) {
       layout.xyz[k] = where[X + k];
