@@ -123,6 +123,51 @@ def seam_spread(out, rest_info, split):
     return spread / diagonal
 
 
+def gltf_json(path):
+    data = path.read_bytes()
+    if path.suffix.lower() == ".gltf":
+        return json.loads(data)
+    length = int.from_bytes(data[12:16], "little")
+    return json.loads(data[20:20 + length])
+
+
+def container_and_twin_checks(cli, path, scene, out, out_dir):
+    """The other container keeps the document (materials, extensions, node names), validates no
+    worse; a second output into the same folder leaves the first as it was."""
+    problems = []
+    other = out_dir / ("other" + (".gltf" if path.suffix.lower() == ".glb" else ".glb"))
+    run = subprocess.run([cli, "deform", str(path), "--scene", str(scene), "-o", str(other)],
+                         capture_output=True, text=True)
+    if run.returncode != 0:
+        return ["to the other container: " + run.stderr.strip()]
+    a, b = gltf_json(out), gltf_json(other)  # the same deformation in the two containers
+    for key in ("materials", "extensionsUsed", "skins", "animations", "textures", "samplers"):
+        if a.get(key) != b.get(key):
+            problems.append(f"the other container changed {key}")
+    names = lambda d: [n.get("name") for n in d.get("nodes", [])]
+    if names(b)[:len(names(a))] != names(a):
+        problems.append("the other container changed the nodes")
+    for name in named_files(other):
+        if not (other.parent / name).exists():
+            problems.append(f"the other container names {name}, which is not beside it")
+    codes = validator_codes([out, other])
+    if codes[str(other)] and codes[str(out)] and codes[str(other)][0] - codes[str(out)][0]:
+        problems.append("the other container has new validator codes: " +
+                        ", ".join(sorted(codes[str(other)][0] - codes[str(out)][0])))
+    before = specdeform.read_mesh(out, keep=True)[2].info.file_vertices.copy()
+    twin = out_dir / ("twin" + path.suffix)
+    spec = json.loads(scene.read_text())
+    spec["handles"][0]["transform"]["translate"] = [-x for x in spec["handles"][0]["transform"]["translate"]]
+    scene2 = out_dir / "bend2.json"
+    scene2.write_text(json.dumps(spec))
+    subprocess.run([cli, "deform", str(path), "--scene", str(scene2), "-o", str(twin)],
+                   capture_output=True, check=False)
+    after = specdeform.read_mesh(out, keep=True)[2].info.file_vertices
+    if not np.array_equal(before, after):
+        problems.append("a second output into the folder changed the first")
+    return problems
+
+
 def try_file(cli, path, work):
     result = {"file": str(path), "problems": []}
     p = result["problems"]
@@ -161,6 +206,7 @@ def try_file(cli, path, work):
     elif path.suffix.lower() == ".gltf" and same.read_text() != path.read_text():
         p.append("nothing moved, yet the .gltf's JSON came back different")
     if path.suffix.lower() in (".gltf", ".glb"):
+        p.extend(container_and_twin_checks(cli, path, scene, out, out_dir))
         codes = validator_codes([path, out])
         before, after = codes[str(path)], codes[str(out)]
         if after is None:

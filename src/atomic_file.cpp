@@ -12,6 +12,21 @@
 
 namespace specdeform {
 
+void check_writable(const std::filesystem::path& path) {
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw InputError(path.string() + ": is a folder, not a file to write");
+  }
+  if (!std::filesystem::is_directory(dir, ec)) {
+    throw InputError(path.string() + ": the folder " + dir.string() + " does not exist");
+  }
+  if (access(dir.c_str(), W_OK | X_OK) != 0) {
+    throw InputError(path.string() + ": cannot write in the folder " + dir.string() + ": " +
+                     std::strerror(errno));
+  }
+}
+
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
   write_file_atomically(path, std::span(&bytes, 1));
 }

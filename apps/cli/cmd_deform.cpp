@@ -45,6 +45,7 @@ void add_deform_command(CLI::App& app) {
   add_harmonics_options(*cmd, args->harmonics);
   add_write_options(*cmd, args->write);
   cmd->callback([args, cmd] {
+    check_mesh_output(args->output);
     // The scene's settings override the defaults; options given on the command line win.
     const LoadedScene loaded_scene = load_scene(args->mesh, args->scene, args->deform.options);
     const LoadedMesh& loaded = loaded_scene.mesh;

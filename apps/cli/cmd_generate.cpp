@@ -38,6 +38,7 @@ void add_generate_command(CLI::App& app) {
   cmd->add_option("--length", args->length, "bar length (default 4) or tube length (default 6)")
       ->check(kPositive);
   cmd->callback([args] {
+    check_mesh_output(args->output);
     TriangleMesh mesh;
     const std::string& shape = args->shape;
     if (shape == "bumpy-bar") {

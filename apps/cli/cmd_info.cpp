@@ -5,6 +5,7 @@
 
 #include "common.h"
 #include "specdeform/mesh/mesh_info.h"
+#include "specdeform/spectral/manifold_harmonics.h"
 
 namespace specdeform::cli {
 
@@ -19,12 +20,43 @@ void add_info_command(CLI::App& app) {
   cmd->add_flag("--json", args->json, "print one JSON object");
   cmd->callback([args] {
     const auto& [path, json] = *args;
-    const LoadedMesh loaded = read_mesh(path, {.keep_file = true, .companions = {}});
-    const MeshInfo i = compute_mesh_info(loaded.mesh);
-    const FileSummary contents = loaded.file->summary();
+    const MeshFileReport report = inspect_mesh_file(path);
+    const FileSummary& contents = report.contents;
     nlohmann::ordered_json j;
     j["file"] = path;
     j["format"] = contents.format;
+    const auto text = [](const nlohmann::ordered_json& v) {
+      return v.is_string() ? v.get<std::string>() : json_text(v);
+    };
+    const auto print = [&] {
+      if (json) {
+        std::cout << text(j) << "\n";
+        return;
+      }
+      for (const auto& [key, value] : j.items()) {
+        if (!value.is_null()) std::cout << key << ": " << text(value) << "\n";
+      }
+    };
+    const auto gltf = [&] {
+      return nlohmann::ordered_json{{"nodes", contents.nodes},
+                                    {"meshes", contents.meshes},
+                                    {"drawings", contents.drawings},
+                                    {"primitives", contents.primitives},
+                                    {"skins", contents.skins},
+                                    {"animations", contents.animations},
+                                    {"morph_targets", contents.morph_targets},
+                                    {"images", contents.images},
+                                    {"extensions", contents.extensions}};
+    };
+    if (!report.loaded) {  // what the file holds, and why deform would refuse it
+      j["materials"] = contents.materials;
+      j["gltf"] = gltf();
+      j["deform"] = {{"ok", false}, {"refused", report.refused}};
+      print();
+      return;
+    }
+    const LoadedMesh& loaded = *report.loaded;
+    const MeshInfo i = compute_mesh_info(loaded.mesh);
     j["vertices"] = i.vertices;
     j["faces"] = i.faces;
     j["edges"] = i.edges;
@@ -79,25 +111,16 @@ void add_info_command(CLI::App& app) {
     j["materials"] = contents.materials;
     j["groups"] = contents.groups;
     if (loaded.file->format == MeshFormat::Gltf || loaded.file->format == MeshFormat::Glb) {
-      j["gltf"] = {{"meshes", contents.meshes},
-                   {"primitives", contents.primitives},
-                   {"skins", contents.skins},
-                   {"animations", contents.animations},
-                   {"morph_targets", contents.morph_targets},
-                   {"images", contents.images}};
+      j["gltf"] = gltf();
     }
     if (!contents.properties.empty()) j["properties"] = contents.properties;
     j["round_trip_keeps"] = contents.round_trip;
-    const auto text = [](const nlohmann::ordered_json& v) {
-      return v.is_string() ? v.get<std::string>() : json_text(v);
-    };
-    if (json) {
-      std::cout << text(j) << "\n";
-      return;
-    }
-    for (const auto& [key, value] : j.items()) {
-      if (!value.is_null()) std::cout << key << ": " << text(value) << "\n";
-    }
+    nlohmann::ordered_json deform = {{"ok", true}};
+    if (!contents.changes.empty()) deform["writing_changes"] = contents.changes;
+    const int modes = default_modes(loaded.mesh.num_vertices());
+    if (modes < ManifoldHarmonicsOptions{}.num_modes) deform["default_modes"] = modes;
+    j["deform"] = deform;
+    print();
   });
 }
 

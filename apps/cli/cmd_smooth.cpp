@@ -25,6 +25,7 @@ void add_smooth_command(CLI::App& app) {
   add_harmonics_options(*cmd, args->options);
   add_write_options(*cmd, args->write);
   cmd->callback([args, cmd] {
+    check_mesh_output(args->output);
     const LoadedMesh loaded = load_mesh(args->mesh);
     ManifoldHarmonicsOptions o = args->options;
     o.num_modes = modes_for(o.num_modes, cmd->count("--modes") > 0, loaded.mesh.num_vertices());

@@ -24,6 +24,7 @@ void add_subdivide_command(CLI::App& app) {
   cmd->add_option("--scheme", args->scheme, "loop (default) or midpoint")
       ->transform(CLI::CheckedTransformer(kSchemes, CLI::ignore_case));
   cmd->callback([args] {
+    check_mesh_output(args->output);
     const LoadedMesh loaded = load_mesh(args->mesh);
     const TriangleMesh fine = subdivide(loaded.mesh, args->levels, args->scheme);
     write_mesh(args->output, fine);

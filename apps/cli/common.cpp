@@ -294,6 +294,11 @@ FrameTimings median_frame(SpectralDeformer& deformer,
   return {median(reduced), median(inverse), median(detail), median(total)};
 }
 
+void check_mesh_output(const std::string& path) {
+  mesh_format_from_path(path);
+  check_writable(path);
+}
+
 int modes_for(int requested, bool asked, int vertices) {
   if (asked) return requested;
   const int modes = default_modes(vertices);

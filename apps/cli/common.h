@@ -90,6 +90,10 @@ struct LoadedScene {
 LoadedScene load_scene(const std::string& mesh_path, const SceneArgs& args,
                        const DeformOptions& defaults);
 
+// Refuses a mesh output that could not be written (its format unknown, its folder missing or
+// not writable) before any work.
+void check_mesh_output(const std::string& path);
+
 // m for a mesh of `vertices` vertices: `requested` where the user asked for it (-m, a scene's
 // "modes"), else the default, lowered to the mesh's vertices with a note on stderr.
 int modes_for(int requested, bool asked, int vertices);

@@ -71,14 +71,18 @@ py::dict summary_dict(const FileSummary& s) {
   d["vertex_colours"] = s.vertex_colours;
   d["materials"] = s.materials;
   d["groups"] = s.groups;
+  d["nodes"] = s.nodes;
   d["meshes"] = s.meshes;
+  d["drawings"] = s.drawings;
   d["primitives"] = s.primitives;
   d["skins"] = s.skins;
   d["animations"] = s.animations;
   d["morph_targets"] = s.morph_targets;
   d["images"] = s.images;
+  d["extensions"] = s.extensions;
   d["properties"] = s.properties;
   d["round_trip_keeps"] = s.round_trip;
+  d["writing_changes"] = s.changes;
   return d;
 }
 

@@ -239,8 +239,11 @@ LoadedMesh read_mesh_from_memory(std::string_view data, MeshFormat format, std::
   return out;
 }
 
-LoadedMesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
-  const MeshFormat format = mesh_format_from_path(path);
+namespace {
+
+// The file's bytes; a binary STL's first triangles are checked before the rest is read (a
+// garbage file is refused at once).
+std::string file_bytes(const std::filesystem::path& path, MeshFormat format) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError(path.string() + ": is a directory");
   std::ifstream file(path, std::ios::binary);
@@ -252,18 +255,43 @@ LoadedMesh read_mesh(const std::filesystem::path& path, const ReadOptions& optio
   while (file.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || file.gcount() > 0) {
     const std::string_view piece(chunk.data(), static_cast<size_t>(file.gcount()));
     if (first && !ec) {
-      // A binary STL's first triangles are checked before the rest is read: a garbage file is
-      // refused at once. The buffer then takes the whole file (no regrowth).
       if (format == MeshFormat::Stl) detail::check_stl_start(piece, size, path.string());
-      bytes.reserve(size);
+      bytes.reserve(size);  // the buffer then takes the whole file (no regrowth)
     }
     first = false;
     bytes.append(piece);
   }
   if (file.bad()) throw InputError(path.string() + ": read error");
+  return bytes;
+}
+
+}  // namespace
+
+LoadedMesh read_mesh(const std::filesystem::path& path, const ReadOptions& options) {
+  const MeshFormat format = mesh_format_from_path(path);
+  const std::string bytes = file_bytes(path, format);
   ReadOptions o = options;
   if (!o.companions) o.companions = folder_resolver(path.parent_path());
   return read_mesh_from_memory(bytes, format, path.string(), o);
+}
+
+MeshFileReport inspect_mesh_file(const std::filesystem::path& path) {
+  const MeshFormat format = mesh_format_from_path(path);
+  const std::string bytes = file_bytes(path, format);
+  const FileResolver companions = folder_resolver(path.parent_path());
+  MeshFileReport report;
+  try {
+    report.loaded = read_mesh_from_memory(bytes, format, path.string(),
+                                          {.keep_file = true, .companions = companions});
+    report.contents = report.loaded->file->summary();
+    return report;
+  } catch (const InputError& e) {
+    if (format != MeshFormat::Gltf && format != MeshFormat::Glb) throw;
+    report.refused = e.what();
+  }
+  report.contents =
+      detail::gltf_document_summary(bytes, format, path.string(), detail::uri_resolver(companions));
+  return report;
 }
 
 MeshReadInfo identity_read_info(const TriangleMesh& mesh) {

@@ -48,6 +48,16 @@ printf '# lift\n1 0 0 0\n0 1 0 0\n0 0 1 0.2\n0 0 0 1\n' >"$tmp/p.def"
 expect 0 "$bin" deform "$tmp/p.off" --sel "$tmp/p.sel" --def "$tmp/p.def" -m 30 -o "$tmp/d.obj"
 expect 0 "$bin" deform "$tmp/p.off" --sel "$tmp/p.sel" --def "$tmp/p.def" --solver spatial --detail none -o "$tmp/s.obj"
 expect 2 "$bin" deform "$tmp/p.off" -o "$tmp/x.off"
+# An output that could not be written is refused before the solve, naming the folder.
+expect 1 "$bin" deform "$tmp/p.off" --scene "$tmp/scene.json" -o "$tmp/no such folder/d.off"
+grep -qF 'no such folder does not exist' "$tmp/err" || { echo "FAIL: missing folder: $(cat "$tmp/err")"; fails=$((fails + 1)); }
+expect 1 "$bin" smooth "$tmp/p.off" -o "$tmp/d.xyz"
+expect 1 "$bin" subdivide "$tmp/p.off" -o "$tmp"
+# The default m on a mesh of fewer vertices: lowered, with a note.
+printf 'OFF\n8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n' >"$tmp/box.off"
+printf '{"handles": [{"vertices": [6], "transform": {"translate": [0, 0, 0.2]}}], "fixed": [0]}' >"$tmp/box.json"
+expect 0 "$bin" deform "$tmp/box.off" --scene "$tmp/box.json" -o "$tmp/box-d.off"
+grep -qF 'note: m = 7: the mesh has only 8 vertices' "$tmp/err" || { echo "FAIL: small mesh: $(cat "$tmp/err")"; fails=$((fails + 1)); }
 expect 2 "$bin" deform "$tmp/p.off" --sel "$tmp/p.sel" -o "$tmp/x.off"
 expect 2 "$bin" deform "$tmp/p.off" --scene "$tmp/scene.json" --detail sideways -o "$tmp/x.off"
 head -5 "$tmp/p.sel" >"$tmp/short.sel"

@@ -18,7 +18,8 @@
 //    where their positions coincide exactly (the file's numbering stays the file's).
 //  - STL: ascii and binary; exactly coincident corners are welded into shared vertices, so file
 //    triangle t has the corners F(t, 0..2) (no triangle is reordered).
-//  - glTF 2.0 (src/mesh/formats/gltf): the triangle primitives of the meshes the default scene draws, in
+//  - glTF 2.0 (src/mesh/formats/gltf): the triangle primitives of the meshes the default scene
+//  draws, in
 //    world space; the vertices glTF splits along seams welded by position.
 // Every reader validates what it reads and throws InputError with a one-line message naming the
 // file: empty file, header only, no faces, index out of range, NaN/Inf coordinates, truncated
@@ -36,6 +37,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -81,6 +83,17 @@ LoadedMesh read_mesh(const std::filesystem::path& path, const ReadOptions& optio
 // Parses a file held in memory; `name` is used in error messages only.
 LoadedMesh read_mesh_from_memory(std::string_view data, MeshFormat format, std::string_view name,
                                  const ReadOptions& options = {});
+
+// What a file holds and what `deform` would do with it (`info`): the mesh read whole, or, for a
+// glTF that parses but draws nothing that can be deformed (no triangles, a node reached twice,
+// a bad index...), the document's contents and the one-line reason. Throws InputError where the
+// file cannot be parsed at all, or where another format yields no mesh.
+struct MeshFileReport {
+  FileSummary contents;
+  std::optional<LoadedMesh> loaded;  // read with keep_file
+  std::string refused;               // why not, when `loaded` is empty
+};
+MeshFileReport inspect_mesh_file(const std::filesystem::path& path);
 
 // What reading `mesh` from a file would record when nothing is dropped or merged (for meshes
 // made in memory, e.g. by generate.h).

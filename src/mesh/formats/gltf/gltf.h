@@ -62,8 +62,14 @@ EncodedMesh rewrite_gltf(const MeshFile& file, const Vertices& positions,
 std::string gltf_bytes(const FileAttributes& a, const Vertices& X, const Eigen::MatrixX3d& normals,
                        bool binary, const MeshFile* file);
 
-// What the file holds (MeshFile::summary's glTF part).
+// What the file holds (MeshFile::summary's glTF part): the document's nodes, meshes, primitives,
+// skins, animations, images, materials and extensions; with a layout, the meshes, drawings and
+// triangle primitives of the default scene.
+void summarize_gltf_document(const GltfDocument& doc, FileSummary& s);
 void summarize_gltf(const GltfLayout& layout, FileSummary& s);
+// The document's summary of a file that parses but draws nothing deform can take (inspect).
+FileSummary gltf_document_summary(std::string_view data, MeshFormat format,
+                                  const std::string& name, const FileResolver& companions);
 
 // Image `image`'s bytes and MIME type, wherever it lives (a buffer view, a data URI); nullopt
 // for one in a file (read it through the companions) or out of range.

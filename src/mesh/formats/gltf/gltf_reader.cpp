@@ -1,6 +1,7 @@
 // glTF read into a polygon soup and kept (gltf.h).
 #include <map>
 #include <set>
+#include <tuple>
 
 #include <Eigen/Dense>
 
@@ -284,13 +285,39 @@ PolygonSoup parse_gltf(std::string_view data, MeshFormat format, const std::stri
   }
 }
 
+void summarize_gltf_document(const GltfDocument& doc, FileSummary& s) {
+  const Json& json = doc.json;
+  s.nodes = int(array_at(json, "nodes").size());
+  s.meshes = int(array_at(json, "meshes").size());
+  s.primitives = 0;
+  for (const Json& mesh : array_at(json, "meshes"))
+    s.primitives += int(array_at(mesh, "primitives").size());
+  s.skins = int(array_at(json, "skins").size());
+  s.animations = int(array_at(json, "animations").size());
+  s.images = int(array_at(json, "images").size());
+  if (s.materials.empty()) {
+    for (const Json& m : array_at(json, "materials")) s.materials.push_back(m.value("name", ""));
+  }
+  for (const Json& e : array_at(doc.original, "extensionsUsed"))
+    if (e.is_string()) s.extensions.push_back(e.get<std::string>());
+  s.round_trip = "everything; POSITION, NORMAL and TANGENT rewritten (with their min and max)";
+  for (const char* compressed : {"KHR_draco_mesh_compression", "EXT_meshopt_compression"}) {
+    if (doc.uses(compressed)) {
+      s.changes.push_back(std::string("primitives compressed by ") + compressed +
+                          " are written uncompressed where their positions change");
+    }
+  }
+}
+
 void summarize_gltf(const GltfLayout& layout, FileSummary& s) {
+  summarize_gltf_document(layout.doc, s);
   const Json& json = layout.doc.json;
   std::set<int> meshes;
-  std::set<std::pair<int, int>> drawings, primitives;
+  std::set<std::tuple<int, int, int>> drawings;
+  std::set<std::pair<int, int>> primitives;
   for (const GltfUnit& u : layout.units) {
     meshes.insert(u.mesh);
-    drawings.insert({u.mesh, u.node});
+    drawings.insert({u.mesh, u.node, u.instance});
     if (!primitives.insert({u.mesh, u.primitive}).second) continue;
     const Json& prim = json["meshes"][u.mesh]["primitives"][u.primitive];
     s.morph_targets += int(array_at(prim, "targets").size());
@@ -298,22 +325,21 @@ void summarize_gltf(const GltfLayout& layout, FileSummary& s) {
     while (prim["attributes"].contains("TEXCOORD_" + std::to_string(sets))) ++sets;
     s.uv_sets = std::max(s.uv_sets, sets);
   }
-  s.nodes = int(array_at(json, "nodes").size());
   s.meshes = int(meshes.size());
   s.drawings = int(drawings.size());
   s.primitives = int(layout.units.size());
-  s.skins = int(array_at(json, "skins").size());
-  s.animations = int(array_at(json, "animations").size());
-  s.images = int(array_at(json, "images").size());
-  for (const Json& e : array_at(layout.doc.original, "extensionsUsed"))
-    if (e.is_string()) s.extensions.push_back(e.get<std::string>());
-  s.round_trip = "everything; POSITION, NORMAL and TANGENT rewritten (with their min and max)";
-  for (const char* compressed : {"KHR_draco_mesh_compression", "EXT_meshopt_compression"}) {
-    if (layout.doc.uses(compressed)) {
-      s.changes.push_back(std::string("primitives compressed by ") + compressed +
-                          " are written uncompressed where their positions change");
-    }
+}
+
+FileSummary gltf_document_summary(std::string_view data, MeshFormat format, const std::string& name,
+                                  const FileResolver& companions) {
+  FileSummary s;
+  s.format = format_name(format);
+  try {
+    summarize_gltf_document(load_gltf_document(data, format, name, companions), s);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(name + ": malformed glTF (" + e.what() + ")");
   }
+  return s;
 }
 
 std::optional<std::pair<std::string, std::string>> gltf_image(const GltfDocument& doc, int image) {
