@@ -10,6 +10,10 @@ Writes to OUT:
   beast.obj          quads and n-gons with their texture coordinates and normals
   cad_part.obj/.glb  a machined part: a cylinder whose 48-gon caps meet its smooth side at
                      hard edges (auto smooth 30 degrees)
+  fleet.glb          a scene: the spot cow drawn by three objects that share its mesh (linked
+                     duplicates: one glTF mesh drawn by three nodes) under a turned parent, a
+                     clear-coated and emissive textured material, named nodes
+  fleet.gltf         the same as a .gltf with its buffer (fleet.bin) and texture beside it
 """
 
 import math
@@ -98,4 +102,33 @@ bpy.ops.object.shade_smooth()
 mesh.use_auto_smooth = True
 mesh.auto_smooth_angle = math.radians(30)
 export(part, "cad_part")
+# A scene: one mesh drawn by three objects under a turned parent.
+bpy.ops.object.select_all(action="DESELECT")
+fleet = bpy.data.objects.new("fleet", None)
+bpy.context.scene.collection.objects.link(fleet)
+fleet.rotation_euler = (0.3, 0.0, 0.7)
+glossy = textured_material("Glossy", os.path.join(out, "fleet_texture.png"))
+principled = glossy.node_tree.nodes["Principled BSDF"]
+principled.inputs["Clearcoat"].default_value = 0.6
+principled.inputs["Emission"].default_value = (0.2, 0.1, 0.0, 1.0)
+cows = []
+for i in range(3):
+    cow = spot.copy()  # shares spot's mesh
+    cow.name = f"cow {i}"
+    cow.parent = fleet
+    cow.location = (1.5 * i, 0.4 * i, 0.0)
+    cow.rotation_euler = (0.0, 0.0, 0.5 * i)
+    bpy.context.scene.collection.objects.link(cow)
+    cows.append(cow)
+spot.data.materials.clear()
+spot.data.materials.append(glossy)
+spot.hide_set(True)
+bpy.ops.object.select_all(action="DESELECT")
+fleet.select_set(True)
+for cow in cows:
+    cow.select_set(True)
+bpy.ops.export_scene.gltf(filepath=os.path.join(out, "fleet.glb"), export_format="GLB",
+                          use_selection=True)
+bpy.ops.export_scene.gltf(filepath=os.path.join(out, "fleet.gltf"), export_format="GLTF_SEPARATE",
+                          use_selection=True)
 print("exported to", out)
