@@ -1,5 +1,7 @@
 #include "editor_session.h"
 
+#include "archive.h"
+
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -341,15 +343,29 @@ void EditorSession::text_message(std::string_view message) {
       return send_(
           true, encode_file({out.string(), encode_mesh(file_order, mesh_format_from_path(out))}));
     }
-    // Companions first: the browser saves each file it is sent.
+    // One download that works where it is saved: the file alone, or an archive of it with
+    // every file it names (a .gltf's buffers and images, an OBJ's MTL and its images).
     EncodedMesh encoded = encode_mesh_file(*s.loaded.file, file_order.V, out);
-    for (size_t f = encoded.files.size(); f-- > 0;) {
-      send_(true, encode_file({encoded.files[f].name, std::move(encoded.files[f].bytes)}));
+    for (const std::string& name : encoded.companions) {
+      std::optional<std::string> bytes;
+      try {
+        bytes = s.loaded.file->companions ? s.loaded.file->companions(name) : std::nullopt;
+      } catch (const InputError&) {
+      }
+      if (bytes) {
+        encoded.files.push_back({name, std::move(*bytes)});
+      } else {
+        encoded.notes.push_back(name + ", which it names, was not found: not in the export");
+      }
     }
     for (const std::string& note : encoded.notes) {
       send_(false, dump({{"type", "note"}, {"message", out.string() + ": " + note}}));
     }
-    return;
+    if (encoded.files.size() == 1) {
+      return send_(true, encode_file({out.string(), std::move(encoded.files[0].bytes)}));
+    }
+    const std::string archive = out.stem().string() + ".zip";
+    return send_(true, encode_file({archive, zip_archive(encoded.files)}));
   }
   if (type == "export_scene") {
     if (s.pose > 0) {

@@ -18,8 +18,9 @@
 //     {"type": "undo"}, {"type": "redo"}
 //     {"type": "apply_pose"}         the shown result becomes the rest shape (pins become fixed)
 //     {"type": "preview", "vertices": k}   a coarse mesh for drags (preview.h)
-//     {"type": "export_mesh", "format": "obj|off|ply|stl|gltf|glb"}   answered with a file
-//                                    message per file written (a .gltf's buffers after it); without
+//     {"type": "export_mesh", "format": "obj|off|ply|stl|gltf|glb"}   answered with one file
+//                                    message: the mesh, or a .zip of it with every file it names
+//                                    (a .gltf's buffers and images, an MTL and its images); without
 //                                    "format", the opened file's own, everything in it kept
 //     {"type": "export_scene"}       the scene JSON of `specdeform deform --scene`
 //     {"type": "cancel"}             handled by the server at once: see cancel()

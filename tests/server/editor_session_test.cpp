@@ -8,12 +8,14 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <numeric>
 #include <thread>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <zip.h>
 
 #include "pose.h"
 #include "preview.h"
@@ -715,6 +717,73 @@ TEST(Pose, AReusedBasisIsExactForARigidMotion) {
   TriangleMesh stretched = mesh;
   stretched.V.col(0) *= 3.0;
   EXPECT_GT(reuse_basis(stretched, basis).max_residual, kReuseResidual);
+}
+
+}  // namespace
+}  // namespace specdeform::server
+
+namespace specdeform::server {
+namespace {
+
+// The files of a zip archive by name (libzip).
+std::map<std::string, std::string> unzip(const std::string& bytes) {
+  zip_error_t error;
+  zip_error_init(&error);
+  zip_source_t* source = zip_source_buffer_create(bytes.data(), bytes.size(), 0, &error);
+  zip_t* archive = zip_open_from_source(source, ZIP_RDONLY, &error);
+  EXPECT_NE(archive, nullptr);
+  std::map<std::string, std::string> out;
+  for (zip_int64_t i = 0; archive && i < zip_get_num_entries(archive, 0); ++i) {
+    zip_stat_t stat;
+    zip_stat_index(archive, i, 0, &stat);
+    std::string data(stat.size, '\0');
+    zip_file_t* f = zip_fopen_index(archive, i, 0);
+    zip_fread(f, data.data(), data.size());
+    zip_fclose(f);
+    out[stat.name] = std::move(data);
+  }
+  if (archive) zip_close(archive);
+  return out;
+}
+
+// A textured OBJ opened with its MTL and image: exported as opened, one archive of the three
+// that opens again where it is unpacked; a format that holds everything (.glb) is one file.
+TEST(EditorSessionExport, ASetThatWorksWhereItIsSaved) {
+  std::vector<Sent> sent;
+  EditorSession session(EditorConfig{.modes = 20, .options = linear_options()},
+                        [&](bool binary, std::string data) {
+                          sent.push_back({binary, std::move(data)});
+                        });
+  const std::string obj =
+      "mtllib box materials.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\n"
+      "v 0 1 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl skin\nf 1/1 4/2 3/3 2/4\n"
+      "f 5/1 6/2 7/3 8/4\nf 1/1 2/2 6/3 5/4\nf 2/1 3/2 7/3 6/4\nf 3/1 4/2 8/3 7/4\n"
+      "f 4/1 1/2 5/3 8/4\n";
+  const std::string mtl = "newmtl skin\nKd 1 1 1\nmap_Kd -s 1 1 1 box skin.png\n";
+  const std::string png = "\x89PNG not really";
+  session.handle(true, encode_file({"box materials.mtl", mtl}, Tag::CompanionFile));
+  session.handle(true, encode_file({"box skin.png", png}, Tag::CompanionFile));
+  session.handle(true, encode_file({"box.obj", obj}, Tag::MeshFile));
+  bool capped = false;
+  for (const Sent& m : sent)
+    if (!m.binary && Json::parse(m.data)["type"] == "note" &&
+        Json::parse(m.data)["message"].get<std::string>().find("m = 7") != std::string::npos)
+      capped = true;
+  EXPECT_TRUE(capped);  // 8 vertices: the default m lowered, said in a note
+  sent.clear();
+  session.handle(false, R"({"type": "export_mesh"})");
+  ASSERT_TRUE(sent.back().binary);
+  const NamedFile archive = decode_file(sent.back().data);
+  EXPECT_EQ(archive.name, "box-deformed.zip");
+  const std::map<std::string, std::string> files = unzip(archive.data);
+  ASSERT_EQ(files.size(), 3u);
+  EXPECT_EQ(files.at("box materials.mtl"), mtl);
+  EXPECT_EQ(files.at("box skin.png"), png);
+  EXPECT_EQ(read_mesh_from_memory(files.at("box-deformed.obj"), MeshFormat::Obj, "o").mesh.V,
+            read_mesh_from_memory(obj, MeshFormat::Obj, "i").mesh.V);
+  sent.clear();
+  session.handle(false, R"({"type": "export_mesh", "format": "glb"})");
+  EXPECT_EQ(decode_file(sent.back().data).name, "box-deformed.glb");
 }
 
 }  // namespace
