@@ -233,7 +233,8 @@ class Rewriter {
       for (const auto& [drawer, own] : drawers)
         if (own == original) kept = &own;
       std::vector<std::pair<const Json*, int>> made{{kept, mesh}};
-      for (const auto& [drawer, own] : drawers) {
+      for (const auto& [drawer, needed] : drawers) {
+        const Json& own = needed;  // a binding a lambda can take
         auto it =
             std::find_if(made.begin(), made.end(), [&](const auto& m) { return *m.first == own; });
         if (it == made.end()) {

@@ -43,7 +43,8 @@ std::string mtl_texture_name(std::string_view rest) {
       {"-o", -3},     {"-s", -3},      {"-t", -3}};
   rest = trimmed(rest);
   for (;;) {
-    const auto [word, after] = first_word(rest);
+    const auto [first, after] = first_word(rest);
+    const std::string_view word = first;  // a binding a lambda can take
     const auto option = std::find_if(std::begin(kOptions), std::end(kOptions),
                                      [&](const auto& o) { return o.first == word; });
     if (option == std::end(kOptions)) break;
