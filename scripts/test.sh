@@ -5,4 +5,5 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/apt_install.sh chromium  # for the editor's end-to-end test
 scripts/setup.sh build
+echo "test: installed and built in ${SECONDS} s"
 ctest --test-dir build --output-on-failure -j "$(nproc)"

@@ -64,6 +64,15 @@ std::optional<Appearance> file_appearance(const LoadedMesh& loaded) {
   for (size_t m = 0; m < M; ++m) {
     for (int k = 0; k < 4; ++k) out.base_color.push_back(a.materials[m].base_color[k]);
     out.textured.push_back(!a.materials[m].texture.empty() || a.materials[m].gltf_image >= 0);
+    out.sampling.push_back(a.materials[m].sampling);
+    if (turn_v) {  // the transform between turned coordinates: turn, transform, turn back
+      Eigen::Matrix3f turn;
+      turn << 1, 0, 0, 0, -1, 1, 0, 0, 1;
+      Eigen::Matrix3f t = Eigen::Matrix3f::Identity();
+      t.topRows<2>() = out.sampling.back().transform;
+      out.sampling.back().transform = (turn * t * turn).topRows<2>();
+    }
+    out.unlit.push_back(a.materials[m].unlit);
   }
   return out;
 }

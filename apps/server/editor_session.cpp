@@ -747,7 +747,15 @@ void EditorSession::send_mesh(const TriangleMesh& rest, const std::optional<Appe
     if (!look->textured[m]) continue;
     if (const auto image = loaded.file->texture(static_cast<int>(m))) {
       send_(true, encode_texture(static_cast<uint32_t>(m), image->second, image->first));
+      continue;
     }
+    const Material& material = loaded.file->attributes.materials[m];
+    const std::string image = material.texture.starts_with("data:") ? "its embedded image"
+                              : material.texture.empty()            ? "its image"
+                                                                    : "'" + material.texture + "'";
+    send_(false, dump({{"type", "note"},
+                       {"message", "material '" + material.name + "': " + image +
+                                       " could not be read; drawn in its colour"}}));
   }
 }
 

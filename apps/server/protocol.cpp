@@ -236,7 +236,7 @@ std::string encode_appearance(const Appearance& a) {
   const uint32_t T = static_cast<uint32_t>(a.corners.size() / 3);
   const uint32_t M = static_cast<uint32_t>(a.textured.size());
   Writer w;
-  w.reserve(20 + 4 * (2 * R + 3 * T + M + 2 + 5 * M) + 4 * a.uv.size() + a.rgba.size() + 4);
+  w.reserve(20 + 4 * (2 * R + 3 * T + M + 2 + 12 * M) + 4 * a.uv.size() + a.rgba.size() + 4);
   w.put(static_cast<uint32_t>(Tag::Appearance));
   w.put(R);
   w.put(T);
@@ -248,6 +248,14 @@ std::string encode_appearance(const Appearance& a) {
   for (const uint32_t s : a.material_start) w.put(s);
   for (const float c : a.base_color) w.put(c);
   for (const char t : a.textured) w.put(static_cast<uint32_t>(t));
+  for (size_t m = 0; m < M; ++m) {  // unlit, nearest, wrap u and v (2 bits each); transform
+    const TextureSampling& t = a.sampling[m];
+    w.put(static_cast<uint32_t>(a.unlit[m] | t.nearest << 1 | int(t.wrap_u) << 2 |
+                                int(t.wrap_v) << 4));
+    for (int r = 0; r < 2; ++r) {
+      for (int c = 0; c < 3; ++c) w.put(t.transform(r, c));
+    }
+  }
   for (const float u : a.uv) w.put(u);
   for (const uint8_t c : a.rgba) w.put(c);
   w.align4();

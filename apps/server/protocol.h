@@ -41,6 +41,8 @@
 //                  u32 normal group (R) | u32 corners (3 T, render numbering) |
 //                  u32 first triangle of each material, then of "none", then T (M + 2) |
 //                  f32 base colour RGBA (4 M) | u32 1 where the material has an image (M) |
+//                  per material: u32 bit 0 unlit, bit 1 nearest, bits 2-3 and 4-5 wrap u and
+//                  v (0 repeat, 1 clamp, 2 mirror) | f32 image transform, 2 rows of 3 (M x 7) |
 //                  f32 uv (2 R, if bit 0) | u8 RGBA (4 R, if bit 1): the file's look
 //                  (appearance.h), after the mesh message of a file that has one
 //   107 texture    u32 tag | u32 material | u32 MIME type length L | MIME type (L bytes, padded

@@ -215,15 +215,35 @@ std::vector<std::string> companion_names(const MeshFile& file) {
   return names;
 }
 
-EncodedMesh encode_mesh_file(const MeshFile& file, const Vertices& positions,
+namespace {
+
+// `positions` with those within kRounding of the bounding box's diagonal from their rest put
+// back at rest: a solve's rounding (a zero deformation's result differs from the input in the
+// last bits) is not a move, so the file's own values, normals included, are written.
+Vertices unmoved_at_rest(const Vertices& rest, const Vertices& positions) {
+  constexpr double kRounding = 1e-10;
+  if (rest.rows() == 0) return positions;
+  const double tolerance =
+      kRounding * (rest.colwise().maxCoeff() - rest.colwise().minCoeff()).norm();
+  Vertices out = positions;
+  for (Eigen::Index v = 0; v < out.rows(); ++v) {
+    if ((out.row(v) - rest.row(v)).cwiseAbs().maxCoeff() <= tolerance) out.row(v) = rest.row(v);
+  }
+  return out;
+}
+
+}  // namespace
+
+EncodedMesh encode_mesh_file(const MeshFile& file, const Vertices& moved,
                              const std::filesystem::path& out_name, const WriteOptions& options) {
-  if (positions.rows() != file.rest.rows()) {
-    throw InputError(out_name.string() + ": " + std::to_string(positions.rows()) +
+  if (moved.rows() != file.rest.rows()) {
+    throw InputError(out_name.string() + ": " + std::to_string(moved.rows()) +
                      " positions for a file of " + std::to_string(file.rest.rows()) + " vertices");
   }
-  if (!positions.allFinite()) {
+  if (!moved.allFinite()) {
     throw InputError(out_name.string() + ": a position is NaN or infinite");
   }
+  const Vertices positions = unmoved_at_rest(file.rest, moved);
   const MeshFormat format = mesh_format_from_path(out_name);
   const FileAttributes& a = file.attributes;
   const Eigen::MatrixX3d normals =

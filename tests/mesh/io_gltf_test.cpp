@@ -647,5 +647,48 @@ TEST(Gltf, ContainerChangeKeepsTheDocument) {
             1e-5);
 }
 
+// A material's base colour image as its texture says: the sampler's wraps and magnification,
+// KHR_texture_transform (offset * rotation * scale); unlit from KHR_materials_unlit.
+TEST(Gltf, MaterialLook) {
+  TestScene scene;
+  tinygltf::Sampler sampler;
+  sampler.wrapS = 33648;     // MIRRORED_REPEAT
+  sampler.wrapT = 33071;     // CLAMP_TO_EDGE
+  sampler.magFilter = 9728;  // NEAREST
+  scene.model.samplers.push_back(sampler);
+  tinygltf::Texture texture;
+  texture.source = 0;
+  texture.sampler = 0;
+  scene.model.textures.push_back(texture);
+  tinygltf::Material material;
+  material.pbrMetallicRoughness.baseColorTexture.index = 0;
+  tinygltf::Value::Object transform;
+  transform["offset"] =
+      tinygltf::Value(tinygltf::Value::Array{tinygltf::Value(0.5), tinygltf::Value(0.25)});
+  transform["rotation"] = tinygltf::Value(0.5);
+  transform["scale"] =
+      tinygltf::Value(tinygltf::Value::Array{tinygltf::Value(2.0), tinygltf::Value(3.0)});
+  material.pbrMetallicRoughness.baseColorTexture.extensions["KHR_texture_transform"] =
+      tinygltf::Value(transform);
+  material.extensions["KHR_materials_unlit"] = tinygltf::Value(tinygltf::Value::Object());
+  scene.model.materials.push_back(material);
+  scene.model.materials.push_back(tinygltf::Material());
+  const LoadedMesh m = keep(scene.glb(), MeshFormat::Glb);
+  const std::vector<Material>& materials = m.file->attributes.materials;
+  ASSERT_EQ(materials.size(), 2u);
+  const TextureSampling& s = materials[0].sampling;
+  EXPECT_EQ(s.wrap_u, TextureSampling::Wrap::Mirror);
+  EXPECT_EQ(s.wrap_v, TextureSampling::Wrap::Clamp);
+  EXPECT_TRUE(s.nearest);
+  EXPECT_TRUE(materials[0].unlit);
+  const float c = std::cos(0.5f), n = std::sin(0.5f);
+  Eigen::Matrix<float, 2, 3> expected;
+  expected << 2 * c, 3 * n, 0.5f, -2 * n, 3 * c, 0.25f;
+  EXPECT_LT((s.transform - expected).cwiseAbs().maxCoeff(), 1e-6f);
+  EXPECT_FALSE(materials[1].unlit);  // no texture: repeat, identity
+  EXPECT_EQ(materials[1].sampling.wrap_u, TextureSampling::Wrap::Repeat);
+  EXPECT_EQ(materials[1].sampling.transform, (Eigen::Matrix<float, 2, 3>::Identity()));
+}
+
 }  // namespace
 }  // namespace specdeform

@@ -98,6 +98,18 @@ TEST(MeshFile, ObjIdentityIsByteForByte) {
   EXPECT_EQ(a.corners[16], 0);
 }
 
+// A zero deformation's rounding (positions off by a few ulps, as a solve gives them) is not a
+// move: the same bytes, normals included; a move just above it is one.
+TEST(MeshFile, RoundingIsNotAMove) {
+  const LoadedMesh m = keep(kCubeObj, MeshFormat::Obj);
+  Vertices X = m.file->rest;
+  X(6, 0) += 1e-15;
+  X(2, 1) -= 3e-16;
+  EXPECT_EQ(write(m, X, "out.obj"), kCubeObj);
+  X(6, 0) += 1e-8;
+  EXPECT_NE(write(m, X, "out.obj"), kCubeObj);
+}
+
 // Moved rigidly: every line but v and vn as it was; v lines at the new positions (colours kept),
 // each hard-edged side's normal turned with it in every mode.
 TEST(MeshFile, ObjMovedKeepsEveryOtherLine) {
@@ -394,12 +406,19 @@ TEST(MeshFile, CompanionsCopiedBesideTheOutput) {
   std::filesystem::create_directories(dir / "in" / "tex");
   std::filesystem::create_directories(dir / "out");
   std::ofstream(dir / "in" / "cube.obj") << kCubeObj;
-  std::ofstream(dir / "in" / "cube.mtl") << "newmtl red\nKd 1 0 0\nmap_Kd -s 1 1 1 tex/red.png\n"
-                                            "newmtl blue\nKd 0 0 1\n";
+  std::ofstream(dir / "in" / "cube.mtl")
+      << "newmtl red\nKd 1 0 0\nmap_Kd -clamp on -s 2 3 1 -o 0.5 0.25 tex/red.png\n"
+         "newmtl blue\nKd 0 0 1\n";
   std::ofstream(dir / "in" / "tex" / "red.png") << "PNG";
   const LoadedMesh m = read_mesh(dir / "in" / "cube.obj", {.keep_file = true, .companions = {}});
   ASSERT_EQ(m.file->attributes.materials[0].texture, "tex/red.png");
   EXPECT_EQ(m.file->attributes.materials[0].base_color, Eigen::Vector4f(1, 0, 0, 1));
+  const TextureSampling& sampling = m.file->attributes.materials[0].sampling;
+  EXPECT_EQ(sampling.wrap_u, TextureSampling::Wrap::Clamp);
+  Eigen::Matrix<float, 2, 3> laid;
+  laid << 2, 0, 0.5, 0, 3, 0.25;  // (2 u + 0.5, 3 v + 0.25)
+  EXPECT_EQ(sampling.transform, laid);
+  EXPECT_EQ(m.file->attributes.materials[1].sampling.wrap_v, TextureSampling::Wrap::Repeat);
   EXPECT_EQ(m.file->texture(0)->first, "PNG");
   EXPECT_EQ(companion_names(*m.file), (std::vector<std::string>{"cube.mtl", "tex/red.png"}));
   write_mesh_file(dir / "out" / "cube.obj", *m.file, m.file->rest);

@@ -387,8 +387,9 @@ try {
     await texturedFiles();
   }
 
-  // A textured .glb: drawn with its image; exported as opened with nothing moved, the same
-  // bytes. An OBJ chosen with its MTL and image: textured as well.
+  // A textured .glb: drawn with its image, a painted handle visible over it; exported as
+  // opened with nothing moved (a handle painted, not dragged), the same bytes. An OBJ chosen
+  // with its MTL and image: textured as well.
   async function texturedFiles() {
     log('textured glTF and OBJ');
     const glb = resolve(args.out, 'cube.glb');
@@ -404,12 +405,45 @@ try {
       check(look.present && look.drawn && look.textures === 1, `${name}: its look is drawn with its image (${JSON.stringify(look)})`);
     };
     await open(glb, 'cube.glb: 8 vertices');
+    await labelOverTexture();
     await page.screenshot({ path: resolve(args.out, 'textured.png') });
     await page.selectOption('#export-format', '');
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#export-mesh')]);
     check(download.suggestedFilename() === 'cube-deformed.glb', `exported as a .glb (${download.suggestedFilename()})`);
     check(readFileSync(await download.path()).equals(readFileSync(glb)), 'the exported .glb, nothing moved, is the opened one');
     await open(writeTexturedObj(args.out), 'cube.obj: 8 vertices');
+  }
+
+  // A handle painted on the textured cube's corner nearest the camera is drawn in the handle's
+  // orange over the image (the checker is red, white and blue): read from a screenshot near it.
+  async function labelOverTexture() {
+    const { corner, centre } = await api(() => {
+      const e = window.specdeformEditor, p = e.restPositions(), c = e.cameraPosition();
+      let corner = 0, centre = { x: 0, y: 0 };
+      for (let v = 0; v < p.length / 3; ++v) {
+        const d = (w) => Math.hypot(p[3 * w] - c[0], p[3 * w + 1] - c[1], p[3 * w + 2] - c[2]);
+        if (d(v) < d(corner)) corner = v;
+        const s = e.vertexOnScreen(v);
+        centre = { x: centre.x + s.x / 8, y: centre.y + s.y / 8 };
+      }
+      return { corner, centre };
+    });
+    await page.click('[data-tool="handle"]');
+    const s = await api((v) => window.specdeformEditor.vertexOnScreen(v), corner);
+    await page.mouse.click(s.x, s.y);
+    await waitReady(30000);
+    await page.waitForTimeout(500); // drawn
+    const at = { x: Math.round(s.x + 0.15 * (centre.x - s.x)), y: Math.round(s.y + 0.15 * (centre.y - s.y)) };
+    const shot = await page.screenshot({ clip: { ...at, width: 1, height: 1 } });
+    const [r, g, b] = await api(async (png) => {
+      const image = new Image();
+      image.src = `data:image/png;base64,${png}`;
+      await image.decode();
+      const canvas = new OffscreenCanvas(1, 1), context = canvas.getContext('2d');
+      context.drawImage(image, 0, 0);
+      return Array.from(context.getImageData(0, 0, 1, 1).data);
+    }, shot.toString('base64'));
+    check(r > 1.3 * g && g > 2 * b, `the painted handle shows over the texture (rgb ${r} ${g} ${b} at ${at.x}, ${at.y})`);
   }
 
   // Typed modal transforms (exact, about the handle's centroid, the result following), cancel,

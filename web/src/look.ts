@@ -1,14 +1,32 @@
 // The file's look (apps/server/appearance.h): the mesh drawn over render vertices with the file's
-// texture coordinates, base colour images, vertex colours and normal groups (hard edges stay
-// hard: the worker sums the faces' normals per group). Handles and fixed vertices are drawn in
-// their colours over it, free vertices in the file's own.
+// texture coordinates, base colour images (laid as the file's samplers say), vertex colours and
+// normal groups (hard edges stay hard: the worker sums the faces' normals per group), unlit
+// materials unshaded. Handles and fixed vertices are drawn in their colours over it (over the
+// texture too: a label attribute replaces the material's colour), free vertices in the file's own.
 import * as THREE from 'three';
-import type { AppearanceMessage } from './protocol';
+import { Wrap, type AppearanceMessage, type MaterialLook } from './protocol';
+
+type LookMaterial = THREE.MeshLambertMaterial | THREE.MeshBasicMaterial;
+
+const wrapping = {
+  [Wrap.Repeat]: THREE.RepeatWrapping,
+  [Wrap.Clamp]: THREE.ClampToEdgeWrapping,
+  [Wrap.Mirror]: THREE.MirroredRepeatWrapping,
+};
+
+// The material's colour (image x base colour x vertex colour) replaced by the vertex's label
+// colour where it has one (label.a = 1).
+function drawLabels(shader: THREE.WebGLProgramParametersWithUniforms): void {
+  shader.vertexShader = `attribute vec4 label;\nvarying vec4 vLabel;\n${shader.vertexShader}`.replace(
+    '#include <begin_vertex>', '#include <begin_vertex>\n  vLabel = label;');
+  shader.fragmentShader = `varying vec4 vLabel;\n${shader.fragmentShader}`.replace(
+    '#include <color_fragment>', '#include <color_fragment>\n  diffuseColor.rgb = mix(diffuseColor.rgb, vLabel.rgb, vLabel.a);');
+}
 
 export class FileLook {
   readonly mesh: THREE.Mesh;
   private readonly geometry = new THREE.BufferGeometry();
-  private materials: THREE.MeshLambertMaterial[] = [];
+  private materials: LookMaterial[] = [];
   private appearance: AppearanceMessage | null = null;
 
   constructor() {
@@ -23,6 +41,20 @@ export class FileLook {
 
   get textures(): number {
     return this.materials.filter((m) => m.map).length;
+  }
+
+  // Why the file's look may show no shape: a material with triangles drawn unlit, or black
+  // without an image (empty: none).
+  get flat(): string {
+    const a = this.appearance;
+    if (!a) return '';
+    for (let m = 0; m < a.materials.length; ++m) {
+      if (a.materialStart[m + 1] === a.materialStart[m]) continue;
+      if (a.materials[m].unlit) return 'unlit';
+      const c = a.baseColor.subarray(4 * m, 4 * m + 3);
+      if (!a.textured[m] && 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2] < 0.01) return 'black';
+    }
+    return '';
   }
 
   // A new file's look, or none (the plain mesh).
@@ -42,29 +74,42 @@ export class FileLook {
     this.geometry.setIndex(new THREE.BufferAttribute(a.indices.slice(), 1));
     this.geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * R), 3));
     this.geometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(3 * R), 3));
-    this.geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * R).fill(1), 3));
+    const color = new Float32Array(3 * R).fill(1);
+    if (a.rgba) for (let i = 0; i < R; ++i) for (let k = 0; k < 3; ++k) color[3 * i + k] = a.rgba[4 * i + k] / 255;
+    this.geometry.setAttribute('color', new THREE.BufferAttribute(color, 3));
+    this.geometry.setAttribute('label', new THREE.BufferAttribute(new Uint8Array(4 * R), 4, true));
     if (a.uv) this.geometry.setAttribute('uv', new THREE.BufferAttribute(a.uv.slice(), 2));
     else this.geometry.deleteAttribute('uv');
     const M = a.textured.length;
     for (let m = 0; m <= M; ++m) {
       const color = m < M ? new THREE.Color().setRGB(a.baseColor[4 * m], a.baseColor[4 * m + 1], a.baseColor[4 * m + 2])
         : new THREE.Color(1, 1, 1);
-      this.materials.push(new THREE.MeshLambertMaterial({ color, vertexColors: true, side: THREE.DoubleSide }));
+      const options = { color, vertexColors: true, side: THREE.DoubleSide };
+      const material = m < M && a.materials[m].unlit ? new THREE.MeshBasicMaterial(options) : new THREE.MeshLambertMaterial(options);
+      material.onBeforeCompile = drawLabels;
+      this.materials.push(material);
       const first = a.materialStart[m], count = a.materialStart[m + 1] - first;
       if (count > 0) this.geometry.addGroup(3 * first, 3 * count, m);
     }
     this.mesh.material = this.materials;
   }
 
-  // Material m's base colour image (v up, as the texture coordinates are).
+  // Material m's base colour image (v up, as the texture coordinates are), laid as it says.
   async setTexture(material: number, mime: string, image: Uint8Array): Promise<void> {
     const target = this.materials[material];
-    if (!target) return;
+    const look: MaterialLook | undefined = this.appearance?.materials[material];
+    if (!target || !look) return;
     const bitmap = await createImageBitmap(new Blob([image as BlobPart], { type: mime }), { imageOrientation: 'flipY' });
     if (this.materials[material] !== target) return; // another file meanwhile
     const texture = new THREE.Texture(bitmap);
     texture.flipY = false; // the bitmap is turned already
     texture.colorSpace = THREE.SRGBColorSpace;
+    texture.wrapS = wrapping[look.wrapU];
+    texture.wrapT = wrapping[look.wrapV];
+    if (look.nearest) texture.magFilter = THREE.NearestFilter;
+    texture.matrixAutoUpdate = false;
+    const t = look.transform;
+    texture.matrix.set(t[0], t[1], t[2], t[3], t[4], t[5], 0, 0, 1);
     texture.needsUpdate = true;
     target.map = texture;
     target.needsUpdate = true;
@@ -94,16 +139,16 @@ export class FileLook {
   setColors(colors: Float32Array, free: THREE.Color): void {
     const a = this.appearance;
     if (!a) return;
-    const c = this.geometry.getAttribute('color') as THREE.BufferAttribute;
-    const out = c.array as Float32Array;
+    const l = this.geometry.getAttribute('label') as THREE.BufferAttribute;
+    const out = l.array as Uint8Array;
+    const [r, g, b] = [free.r, free.g, free.b].map(Math.fround); // as a Float32Array holds them
     for (let i = 0; i < a.vertex.length; ++i) {
       const v = 3 * a.vertex[i];
-      const selected = colors[v] !== free.r || colors[v + 1] !== free.g || colors[v + 2] !== free.b;
-      for (let k = 0; k < 3; ++k) {
-        out[3 * i + k] = selected ? colors[v + k] : a.rgba ? a.rgba[4 * i + k] / 255 : 1;
-      }
+      const selected = colors[v] !== r || colors[v + 1] !== g || colors[v + 2] !== b;
+      for (let k = 0; k < 3; ++k) out[4 * i + k] = selected ? Math.round(255 * colors[v + k]) : 0;
+      out[4 * i + 3] = selected ? 255 : 0;
     }
-    c.needsUpdate = true;
+    l.needsUpdate = true;
   }
 }
 

@@ -157,8 +157,22 @@ export interface AppearanceMessage {
   materialStart: Uint32Array; // material m's triangles [start[m], start[m + 1]); the last: none
   baseColor: Float32Array; // RGBA of each material
   textured: Uint32Array; // 1: the material has an image (a texture message follows)
+  materials: MaterialLook[];
   uv: Float32Array | null; // 2 per render vertex, v up
   rgba: Uint8Array | null; // 4 per render vertex
+}
+
+export const Wrap = { Repeat: 0, Clamp: 1, Mirror: 2 } as const;
+export type Wrap = (typeof Wrap)[keyof typeof Wrap];
+
+// How a material is drawn beyond its colour: shaded or not, and how its image is laid over the
+// texture coordinates (read at transform * (u, v, 1), the wrap outside [0, 1]).
+export interface MaterialLook {
+  unlit: boolean;
+  nearest: boolean;
+  wrapU: Wrap;
+  wrapV: Wrap;
+  transform: Float32Array; // 2 rows of 3
 }
 
 export interface TextureMessage {
@@ -289,13 +303,20 @@ export function decodeAppearance(buffer: ArrayBuffer): AppearanceMessage {
   const baseColor = new Float32Array(buffer, at, 4 * M);
   at += 16 * M;
   const textured = u32(M);
+  const materials: MaterialLook[] = [];
+  for (let m = 0; m < M; ++m) {
+    const [flags] = u32(1);
+    const transform = new Float32Array(buffer, at, 6);
+    at += 24;
+    materials.push({ unlit: (flags & 1) !== 0, nearest: (flags & 2) !== 0, wrapU: ((flags >> 2) & 3) as Wrap, wrapV: ((flags >> 4) & 3) as Wrap, transform });
+  }
   let uv: Float32Array | null = null;
   if (flags & 1) {
     uv = new Float32Array(buffer, at, 2 * R);
     at += 8 * R;
   }
   const rgba = flags & 2 ? new Uint8Array(buffer, at, 4 * R) : null;
-  return { vertex, normalGroup, indices, materialStart, baseColor, textured, uv, rgba };
+  return { vertex, normalGroup, indices, materialStart, baseColor, textured, materials, uv, rgba };
 }
 
 export function decodeTexture(buffer: ArrayBuffer): TextureMessage {

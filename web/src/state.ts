@@ -373,6 +373,8 @@ export class EditorState {
       case P.Tag.Appearance: {
         const a = P.decodeAppearance(buffer);
         this.viewer.setAppearance(a);
+        const flat = this.viewer.look.flat;
+        if (flat) this.note(`the file's ${flat} material shows no shading: untick "file's look" to see the shape`);
         this.post({ kind: 'look', vertex: a.vertex.slice(), group: a.normalGroup.slice(), indices: a.indices.slice() });
         // The shown frame again, with the look's normals.
         const f = this.frame;

@@ -54,6 +54,22 @@ enum class Confinement { Confined, Relative };
 FileResolver folder_resolver(const std::filesystem::path& folder,
                              Confinement confinement = Confinement::Relative);
 
+// How a base colour image is laid over the texture coordinates (u, v as the file has them).
+struct TextureSampling {
+  enum class Wrap {
+    Repeat,
+    Clamp,
+    Mirror
+  };  // outside [0, 1]: glTF's REPEAT, CLAMP_TO_EDGE,
+      // MIRRORED_REPEAT; MTL's -clamp off / on
+  Wrap wrap_u = Wrap::Repeat;
+  Wrap wrap_v = Wrap::Repeat;
+  bool nearest = false;  // magnified by the nearest texel (glTF magFilter NEAREST), not blended
+  // The image is read at (u', v') = transform * (u, v, 1): glTF's KHR_texture_transform
+  // (offset * rotation * scale), MTL's -o and -s. Identity by default.
+  Eigen::Matrix<float, 2, 3> transform = Eigen::Matrix<float, 2, 3>::Identity();
+};
+
 // A material as far as files of different formats share it.
 struct Material {
   std::string name;
@@ -61,6 +77,8 @@ struct Material {
   std::string texture;                     // base colour image: a name for the FileResolver
                                            // (MTL map_Kd, a glTF image's uri), or empty
   int gltf_image = -1;                     // glTF: the image's index (in a buffer view or not)
+  TextureSampling sampling;                // of the base colour image
+  bool unlit = false;                      // drawn without shading (glTF KHR_materials_unlit)
 };
 
 // The surface as the file describes it, in the file's vertex numbering.
@@ -162,8 +180,9 @@ struct EncodedMesh {
 };
 
 // The file with new `positions` (one row per file vertex), in the format of `out_name`'s
-// extension. Throws InputError if the positions do not match the file or cannot be written in
-// its layout.
+// extension. A position within 1e-10 of the bounding box's diagonal from its rest is written as
+// the rest (a solve's rounding, not a move: a zero deformation gives the input's bytes). Throws
+// InputError if the positions do not match the file or cannot be written in its layout.
 EncodedMesh encode_mesh_file(const MeshFile& file, const Vertices& positions,
                              const std::filesystem::path& out_name,
                              const WriteOptions& options = {});

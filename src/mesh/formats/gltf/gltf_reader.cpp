@@ -1,4 +1,5 @@
 // glTF read into a polygon soup and kept (gltf.h).
+#include <cmath>
 #include <map>
 #include <set>
 #include <tuple>
@@ -46,6 +47,43 @@ int texture_image(const Json& json, int texture) {
   return -1;
 }
 
+TextureSampling::Wrap wrap(const Json& sampler, const char* key) {
+  switch (sampler.value(key, 10497)) {
+    case 33071:
+      return TextureSampling::Wrap::Clamp;
+    case 33648:
+      return TextureSampling::Wrap::Mirror;
+    default:
+      return TextureSampling::Wrap::Repeat;
+  }
+}
+
+// A texture reference's sampler and KHR_texture_transform.
+TextureSampling texture_sampling(const Json& json, const Json& info) {
+  TextureSampling out;
+  const Json& samplers = array_at(json, "samplers");
+  const Json& textures = array_at(json, "textures");
+  const int texture = info.value("index", -1);
+  const int s = texture >= 0 && size_t(texture) < textures.size()
+                    ? textures[texture].value("sampler", -1)
+                    : -1;
+  if (s >= 0 && size_t(s) < samplers.size() && samplers[s].is_object()) {
+    out.wrap_u = wrap(samplers[s], "wrapS");
+    out.wrap_v = wrap(samplers[s], "wrapT");
+    out.nearest = samplers[s].value("magFilter", 0) == 9728;
+  }
+  const Json& t = object_at(object_at(info, "extensions"), "KHR_texture_transform");
+  const auto pair = [&](const char* key, float fallback, int k) {
+    const Json& a = array_at(t, key);
+    return a.size() == 2 && a[k].is_number() ? a[k].get<float>() : fallback;
+  };
+  const float r = t.value("rotation", 0.f), c = std::cos(r), sn = std::sin(r);
+  const float sx = pair("scale", 1, 0), sy = pair("scale", 1, 1);
+  out.transform << c * sx, sn * sy, pair("offset", 0, 0),  // offset * rotation * scale
+      -sn * sx, c * sy, pair("offset", 0, 1);
+  return out;
+}
+
 std::vector<Material> materials_of(const Json& json) {
   std::vector<Material> out;
   const Json& images = array_at(json, "images");
@@ -57,12 +95,15 @@ std::vector<Material> materials_of(const Json& json) {
     if (factor.size() == 4) {
       for (int k = 0; k < 4; ++k) mat.base_color[k] = factor[k].get<float>();
     }
-    const int image = texture_image(json, object_at(pbr, "baseColorTexture").value("index", -1));
+    const Json& base = object_at(pbr, "baseColorTexture");
+    const int image = texture_image(json, base.value("index", -1));
     if (image >= 0 && size_t(image) < images.size()) {
       mat.gltf_image = image;
       const std::string uri = images[image].value("uri", "");
       mat.texture = uri.starts_with("data:") ? uri : decode_uri(uri);
+      mat.sampling = texture_sampling(json, base);
     }
+    mat.unlit = object_at(gm, "extensions").contains("KHR_materials_unlit");
     out.push_back(std::move(mat));
   }
   return out;

@@ -382,7 +382,13 @@ class Rewriter {
       bin.bytes += doc_.buffers[b].bytes;
     }
     const auto move = [&](Json& at) {
-      const auto [index, base] = moved[at.value("buffer", 0)];
+      const Json& buffer = at.contains("buffer") ? at["buffer"] : Json();
+      if (!buffer.is_number_integer() || buffer.get<long long>() < 0 ||
+          buffer.get<size_t>() >= moved.size()) {
+        doc_.fail("a buffer view names buffer " + buffer.dump() + " of " +
+                  std::to_string(moved.size()));
+      }
+      const auto [index, base] = moved[buffer.get<size_t>()];
       at["buffer"] = index;
       if (base > 0) at["byteOffset"] = at.value("byteOffset", size_t(0)) + base;
     };

@@ -35,12 +35,14 @@ bool is_texture_statement(std::string_view key) {
 
 }  // namespace
 
-std::string mtl_texture_name(std::string_view rest) {
+MtlTexture mtl_texture(std::string_view rest) {
   // Options with a fixed count of words, and -o, -s and -t with one to three numbers.
   static constexpr std::pair<std::string_view, int> kOptions[] = {
       {"-blendu", 1}, {"-blendv", 1},  {"-bm", 1}, {"-boost", 1},  {"-cc", 1},
       {"-clamp", 1},  {"-imfchan", 1}, {"-mm", 2}, {"-texres", 1}, {"-type", 1},
       {"-o", -3},     {"-s", -3},      {"-t", -3}};
+  MtlTexture out;
+  Eigen::Matrix<float, 2, 3>& transform = out.sampling.transform;  // (u s_u + o_u, v s_v + o_v)
   rest = trimmed(rest);
   for (;;) {
     const auto [first, after] = first_word(rest);
@@ -53,11 +55,20 @@ std::string mtl_texture_name(std::string_view rest) {
       const auto [value, next] = first_word(rest);
       if (option->second < 0 && !is_number(value)) break;  // -s u [v [w]]
       rest = next;
+      float v = 0;
+      std::from_chars(value.data(), value.data() + value.size(), v);
+      if (word == "-clamp" && value == "on") {
+        out.sampling.wrap_u = out.sampling.wrap_v = TextureSampling::Wrap::Clamp;
+      } else if (word == "-s" && k < 2) {
+        transform(k, k) = v;
+      } else if (word == "-o" && k < 2) {
+        transform(k, 2) = v;
+      }
     }
   }
-  std::string name(rest);
-  std::replace(name.begin(), name.end(), '\\', '/');  // written on Windows
-  return name;
+  out.name = rest;
+  std::replace(out.name.begin(), out.name.end(), '\\', '/');  // written on Windows
+  return out;
 }
 
 void read_obj_materials(KeptRecord& record, const FileResolver& companions) {
@@ -93,11 +104,14 @@ void read_obj_materials(KeptRecord& record, const FileResolver& companions) {
           values = next;
         }
       } else if (is_texture_statement(key)) {
-        const std::string name = mtl_texture_name(rest);
-        if (name.empty()) continue;
-        const std::string path = (folder / name).lexically_normal().generic_string();
+        const MtlTexture texture = mtl_texture(rest);
+        if (texture.name.empty()) continue;
+        const std::string path = (folder / texture.name).lexically_normal().generic_string();
         layout.textures.push_back(path);
-        if (current && key == "map_Kd") current->texture = path;
+        if (current && key == "map_Kd") {
+          current->texture = path;
+          current->sampling = texture.sampling;
+        }
       }
     }
   }

@@ -31,10 +31,14 @@ PolygonSoup parse_obj(std::string_view data, const std::string& name, KeptRecord
 // layout; materials it cannot read stay plain.
 void read_obj_materials(KeptRecord& record, const FileResolver& companions);
 
-// The file an MTL texture statement names, from the words after its keyword: the rest of the
-// line after the options (-s 1 1 1, -o, -bm 0.5, -clamp on, ...), spaces kept, backslashes as
-// slashes.
-std::string mtl_texture_name(std::string_view rest);
+// An MTL texture statement, from the words after its keyword: the file it names (the rest of
+// the line after the options -s 1 1 1, -o, -bm 0.5, -clamp on, ...; spaces kept, backslashes
+// as slashes) and how it is laid (-clamp, -o and -s; the other options are skipped).
+struct MtlTexture {
+  std::string name;
+  TextureSampling sampling;
+};
+MtlTexture mtl_texture(std::string_view rest);
 
 // `positions`: one row per file vertex; `normals`: the updated rows of the file's normals
 // (FileAttributes::normals; file_normals.h), empty when it has none.

@@ -20,6 +20,13 @@ using Scalar = PlyScalar;
 using Property = PlyProperty;
 using Element = PlyElement;
 
+// A value as the file holds it, for an error message: it may be 1.5, 1e300 or nan.
+std::string as_read(double v) {
+  char text[32];
+  const auto [end, ec] = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, end);
+}
+
 bool parse_scalar(std::string_view t, Scalar& out) {
   static constexpr std::pair<std::string_view, Scalar> kNames[] = {
       {"char", Scalar::I8},    {"int8", Scalar::I8},     {"uchar", Scalar::U8},
@@ -266,7 +273,7 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name, KeptRecord
         }
         if (count > static_cast<double>(in.remaining())) {  // each value takes a byte at least
           throw InputError(name + ": truncated data (element '" + e.name + "' entry " +
-                           std::to_string(r) + "'s list of " + std::to_string(long(count)) +
+                           std::to_string(r) + "'s list of " + as_read(count) +
                            " values runs past the end)");
         }
         const bool is_face = &e == face && int(i) == face_list;
@@ -278,10 +285,8 @@ PolygonSoup parse_ply(std::string_view data, const std::string& name, KeptRecord
           if (!is_face && !is_strip) continue;
           if (!(v >= (is_strip ? -1 : 0) && v < static_cast<double>(vertex->count)) ||
               v != std::floor(v)) {
-            char text[32];  // v as read: it may be 1.5, 1e300 or nan
-            const auto [end, ec] = std::to_chars(text, text + sizeof text, v);
             throw InputError(name + ": " + (is_face ? "face " : "triangle strip ") +
-                             std::to_string(r) + " references vertex " + std::string(text, end) +
+                             std::to_string(r) + " references vertex " + as_read(v) +
                              " but there are " + std::to_string(vertex->count) + " vertices");
           }
           if (is_face) {
