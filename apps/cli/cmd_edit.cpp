@@ -19,6 +19,18 @@ std::filesystem::path default_cache_dir() {
   return {};
 }
 
+// The editor's page: installed beside the program (`cmake --install`), else the web/dist of the
+// source tree the program was built from.
+std::string default_assets() {
+  std::error_code error;
+  const std::filesystem::path program = std::filesystem::read_symlink("/proc/self/exe", error);
+  const std::filesystem::path installed = program.parent_path() / SPECDEFORM_WEB_FROM_PROGRAM;
+  if (!error && std::filesystem::exists(installed / "index.html", error)) {
+    return installed.lexically_normal().string();
+  }
+  return SPECDEFORM_WEB_DIST;
+}
+
 }  // namespace
 
 void add_edit_command(CLI::App& app) {
@@ -33,7 +45,7 @@ void add_edit_command(CLI::App& app) {
     DeformArgs deform;
   };
   auto args = std::make_shared<Args>();
-  args->server.assets = SPECDEFORM_WEB_DIST;
+  args->server.assets = default_assets();
   args->editor.cache_dir = default_cache_dir();
   cmd->add_option("MESH", args->mesh, "mesh to open (default: the built-in bumpy bar)");
   cmd->add_option("--host", args->server.host,
@@ -49,7 +61,7 @@ void add_edit_command(CLI::App& app) {
   cmd->add_option("--max-upload-mb", args->max_upload_mb,
                   "largest mesh file the browser may send (default 256)")
       ->check(kPositive);
-  cmd->add_option("--assets", args->server.assets, "the built editor (default: web/dist)");
+  cmd->add_option("--assets", args->server.assets, "the built editor (default: the installed page, else web/dist)");
   cmd->callback([args, cmd] {
     args->editor.options = args->deform.merged(*cmd, server::editor_deform_options());
     args->editor.options.validate();
