@@ -61,7 +61,8 @@ void add_edit_command(CLI::App& app) {
   cmd->add_option("--max-upload-mb", args->max_upload_mb,
                   "largest mesh file the browser may send (default 256)")
       ->check(kPositive);
-  cmd->add_option("--assets", args->server.assets, "the built editor (default: the installed page, else web/dist)");
+  cmd->add_option("--assets", args->server.assets,
+                  "the built editor (default: the installed page, else web/dist)");
   cmd->callback([args, cmd] {
     args->editor.options = args->deform.merged(*cmd, server::editor_deform_options());
     args->editor.options.validate();
