@@ -3,6 +3,7 @@
 # C++ library, program, tests and benchmarks, the Python bindings (build/python), the Blender
 # add-on (build/blender; Debian's blender runs its tests) and the browser editor (web/dist, Vite).
 # Usage: scripts/setup.sh [build-dir]      (default: build)
+#        scripts/setup.sh --packages        (the Debian packages only: for pip install .)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -10,9 +11,10 @@ build=${1:-build}
 packages=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libopenblas-dev
           libspectra-dev libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev libboost-dev
           libcgal-dev libtinygltf-dev libdraco-dev libmeshoptimizer-dev libzip-dev python3-dev pybind11-dev python3-numpy python3-scipy python3-pytest
-          python3-matplotlib blender)
+          python3-matplotlib python3-pip python3-venv patchelf blender)
 command -v npm >/dev/null || packages+=(nodejs npm)
 scripts/apt_install.sh "${packages[@]}"
+[ "$build" = --packages ] && exit 0
 
 # The editor's npm packages, pinned by web/package-lock.json; reinstalled when the lock changes.
 # Vite 8 needs Node.js 20.19 or later.

@@ -480,13 +480,11 @@ try {
     };
     const reset = async () => {
       await page.click('#reset');
-      await page.evaluate(() => document.activeElement?.blur());
       await waitReady(60000);
     };
     // Messages over the viewport take clicks: dismissed before clicking the model under them.
     const dismiss = async () => {
       for (const close of await page.$$('#notes .note button')) await close.click().catch(() => {});
-      await page.evaluate(() => document.activeElement?.blur());
     };
     const undoTwice = async () => {
       for (let i = 0; i < 2; ++i) {
@@ -501,7 +499,11 @@ try {
       return c.map((x) => x / n);
     };
     await reset();
+    const view = () => api(() => [window.specdeformEditor.cameraPosition(), window.specdeformEditor.cameraTarget()]);
+    const before = JSON.stringify(await view());
     await page.keyboard.press('4');
+    check(JSON.stringify(await view()) === before, 'switching to Move leaves the view as it was');
+    await page.keyboard.press('NumpadDecimal'); // asked: the handle framed
     // The gizmo is at the pivot, in view and clear of the messages over the viewport.
     const gizmo = await api(() => window.specdeformEditor.gizmoOnScreen());
     const clear = await page.evaluate(() => {
@@ -511,6 +513,11 @@ try {
     check(gizmo && gizmo.x > clear.left && gizmo.x < clear.right && gizmo.y > clear.top && gizmo.y < clear.bottom,
       `the gizmo is in view, below the messages (${JSON.stringify(gizmo)} in ${JSON.stringify(clear)})`);
     const step = Number((0.2 * state.diagonal).toPrecision(1));
+    // Keys act on the view after a panel checkbox was clicked (ticked and unticked here).
+    await page.click('#x-mirror');
+    await page.click('#x-mirror');
+    check(await page.evaluate(() => !document.activeElement || document.activeElement === document.body),
+      `a used checkbox keeps no keyboard focus (${await page.evaluate(() => document.activeElement?.id)})`);
     await keys('g', 'x', ...String(step));
     check(/Move D: .* \[.*\|\] along global X/.test(await page.textContent('#header')), `the header reads the move (${await page.textContent('#header')})`);
     await keys('Enter');
@@ -576,7 +583,6 @@ try {
     const cursor = await api(() => window.specdeformEditor.cursor());
     check(cursor !== null, 'Shift + right-click placed the 3D cursor');
     await page.selectOption('#pivot', 'cursor');
-    await page.evaluate(() => document.activeElement?.blur());
     await keys('r', 'z', '9', '0', 'Enter');
     r = await result();
     const fixedPoint = [0, 1, 2].map((i) => r.t[4 * i] * cursor[0] + r.t[4 * i + 1] * cursor[1] + r.t[4 * i + 2] * cursor[2] + r.t[4 * i + 3]);
@@ -586,8 +592,7 @@ try {
 
     // Individual pivots: a second group at the other end; R Z 90 turns each about its centroid.
     await page.selectOption('#pivot', 'individual');
-    await page.evaluate(() => document.activeElement?.blur());
-    await keys('n', 'Home'); // the first view again (Move may have panned the gizmo into view)
+    await keys('n', 'Home'); // the first view again (numpad . framed the handle)
     await dismiss();
     await click(ends.fixed);
     await keys('4', 'r', 'z', '9', '0', 'Enter');
@@ -604,8 +609,7 @@ try {
     }
     check(both.length === 2, `two groups turned (${both.length})`);
     await undoTwice();
-    await page.selectOption('#pivot', 'median');
-    await page.evaluate(() => document.activeElement?.blur());
+    await page.selectOption('#pivot', 'median'); // a menu used keeps no keyboard either
     await keys('1');
 
     log('region of influence');
@@ -699,6 +703,22 @@ try {
     await waitReady(60000);
     await reset();
 
+    log('select all and none, Tab');
+    await keys('2'); // Fixed: A gives every vertex its label, Alt+A clears it, each one undo step
+    const fixedBefore = await count(1);
+    await keys('a');
+    await waitReady(60000);
+    check((await count(0)) === 0 && (await count(1)) > fixedBefore, `A: no vertex left free (${await count(1)} fixed)`);
+    await keys('Alt+a');
+    await waitReady(60000);
+    check((await count(1)) === 0, `Alt+A: the fixed label cleared (${await count(1)})`);
+    await undoTwice();
+    check((await count(1)) === fixedBefore, `undone twice, the fixed part is back (${await count(1)} of ${fixedBefore})`);
+    await keys('Tab');
+    check((await api(() => window.specdeformEditor.tool())) === 'move', 'Tab: from painting to Move');
+    await keys('Tab');
+    check((await api(() => window.specdeformEditor.tool())) === 'fixed', 'Tab again: back to the tool that paints');
+
     log('box and lasso select');
     const boxSelect = async (lasso = false) => {
       if (lasso) {
@@ -724,10 +744,8 @@ try {
     };
     const visible = await boxSelect();
     await page.check('#xray');
-    await page.evaluate(() => document.activeElement?.blur());
     const through = await boxSelect();
     await page.uncheck('#xray');
-    await page.evaluate(() => document.activeElement?.blur());
     const lassoed = await boxSelect(true);
     log(`box: ${visible} visible, ${through} with X-ray; lasso: ${lassoed}`);
     check(lassoed > 0 && lassoed < visible, `the lasso (a diamond inside the box) selects fewer than the box (${lassoed})`);
@@ -736,7 +754,6 @@ try {
     log('X mirror');
     await page.click('#clear');
     await page.check('#x-mirror');
-    await page.evaluate(() => document.activeElement?.blur());
     await keys('1');
     await dismiss();
     await click(ends.handle);
@@ -759,6 +776,44 @@ try {
     check(other.every((x, i) => Math.abs(x - [1, 0, 0, -step, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1][i]) < 1e-12 * r.diagonal),
       `the mirrored group moves by the mirrored G X ${step} (${other})`);
     await page.uncheck('#x-mirror');
+
+    log('navigation');
+    // A drag with a button (and a key held): how far the camera moved, its target moved (a
+    // pan), and its distance to the target changed (a zoom), over the diagonal.
+    const camera = () => api(() => [window.specdeformEditor.cameraPosition(), window.specdeformEditor.cameraTarget()]);
+    const apart = (a, b) => Math.hypot(...a.map((x, i) => x - b[i]));
+    const drag = async (button, key) => {
+      const [p, t] = await camera();
+      if (key) await page.keyboard.down(key);
+      await page.mouse.move(canvas.x, canvas.y);
+      await page.mouse.down({ button });
+      await page.mouse.move(canvas.x + 80, canvas.y + 30, { steps: 5 });
+      await page.mouse.up({ button });
+      if (key) await page.keyboard.up(key);
+      const [q, u] = await camera();
+      return { moved: apart(p, q) / r.diagonal, panned: apart(t, u) / r.diagonal, zoomed: Math.abs(apart(q, u) - apart(p, t)) / r.diagonal };
+    };
+    const orbits = (m) => m.moved > 1e-3 && m.panned < 1e-9 && m.zoomed < 1e-9;
+    let m = await drag('middle');
+    check(orbits(m), `as Blender, middle-drag orbits (${JSON.stringify(m)})`);
+    m = await drag('middle', 'Shift');
+    check(m.panned > 1e-3, `Shift + middle-drag pans (${JSON.stringify(m)})`);
+    m = await drag('middle', 'Control');
+    check(m.zoomed > 1e-3 && m.panned < 1e-9, `Ctrl + middle-drag zooms (${JSON.stringify(m)})`);
+    m = await drag('right');
+    check(m.moved === 0, `the right button leaves the view (${JSON.stringify(m)})`);
+    await page.check('#emulate3');
+    m = await drag('left', 'Alt');
+    check(orbits(m), `with Alt emulating the middle button, Alt + left-drag orbits (${JSON.stringify(m)})`);
+    await page.uncheck('#emulate3');
+    await page.selectOption('#navigation', 'right');
+    m = await drag('right');
+    check(orbits(m), `the other scheme: right-drag orbits (${JSON.stringify(m)})`);
+    m = await drag('middle');
+    check(m.panned > 1e-3, `the other scheme: middle-drag pans (${JSON.stringify(m)})`);
+    check(JSON.parse(await page.evaluate(() => localStorage.getItem('specdeform.navigation'))).scheme === 'right',
+      'the scheme is kept in the browser');
+    await page.selectOption('#navigation', 'blender');
   }
   check(pageErrors.length === 0, `no page errors: ${pageErrors.join('; ')}`);
 } catch (e) {

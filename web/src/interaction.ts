@@ -30,6 +30,8 @@ interface Drag {
 
 export class Interaction {
   tool: Tool = 'handle';
+  paintTool: Tool = 'handle'; // the last tool that paints: Tab goes back to it from Move
+  emulate3 = false; // Alt + left acts as the middle button (Blender's Emulate 3 Button Mouse)
   onToolChange: () => void = () => {};
   // The stroke being painted; one ended while its last brush query was out is `finishing`
   // (sent when the query is in) and no longer this.
@@ -90,9 +92,10 @@ export class Interaction {
   }
 
   setTool(t: Tool): void {
+    if (t !== 'move') this.paintTool = t;
     this.tool = t;
     if (t !== 'move') this.s.viewer.gizmo.detach();
-    this.placeGizmo(t === 'move');
+    this.placeGizmo();
     this.s.viewer.showBrush(null, 0);
     this.onToolChange();
   }
@@ -124,10 +127,15 @@ export class Interaction {
       this.view.setPointerCapture(e.pointerId);
       return;
     }
+    // The view's buttons (Viewer.setNavigation); as Blender, Ctrl + middle zooms.
+    const blender = v.navigation === 'blender';
+    const orbit = blender && e.ctrlKey ? THREE.MOUSE.DOLLY : THREE.MOUSE.ROTATE;
+    if (blender && e.button === 1) v.orbit.mouseButtons.MIDDLE = orbit;
     // Only presses on the model's canvas: not on what lies over it (messages, dialogs).
-    if (e.button !== 0 || e.target !== v.canvas) return; // right: orbit, middle: pan
-    v.orbit.mouseButtons.LEFT = e.altKey ? THREE.MOUSE.ROTATE : null;
-    if (e.altKey || this.gizmoTakes()) return; // orbit, or the gizmo's own drag
+    if (e.button !== 0 || e.target !== v.canvas) return;
+    const viewButton = e.altKey && (!blender || this.emulate3); // Alt + left: orbit (pan, zoom)
+    v.orbit.mouseButtons.LEFT = viewButton ? orbit : null;
+    if (viewButton || this.gizmoTakes()) return; // the view, or the gizmo's own drag
     e.stopPropagation();
     if (!(this.tool === 'move' ? this.s.editable : this.s.paintable)) {
       this.s.note(this.s.phase.kind === 'disconnected' ? 'not connected: the edit waits for the server'
@@ -150,7 +158,8 @@ export class Interaction {
       this.s.changed();
     } else {
       if (!hit) {
-        this.s.note('missed the model: a stroke starts on the surface (right-drag or Alt+drag orbits)');
+        const orbit = this.s.viewer.navigation === 'blender' ? 'middle-drag orbits' : 'right-drag or Alt+drag orbits';
+        this.s.note(`missed the model: a stroke starts on the surface (${orbit})`);
         return;
       }
       let pin: number | null = null;
@@ -303,7 +312,7 @@ export class Interaction {
     this.s.sendSelection(stroke.pin !== null ? new Set([stroke.pin]) : new Set());
     if (stroke.label >= 2 && stroke.pin === null && this.oneSided(stroke.label)) {
       this.s.note('the handle covers only the side facing you: its centre is on the surface, not in the part, so turns ' +
-        'and scales shift it. Paint through with X-ray (Alt+Z, then B for a box), or orbit (right-drag) and paint around');
+        'and scales shift it. Paint through with X-ray (Alt+Z, then B for a box), or orbit and paint around');
     }
     this.s.changed();
   }
@@ -451,9 +460,9 @@ export class Interaction {
     return this.pivotMode === 'cursor' && this.cursor ? this.cursor.clone() : c.applyMatrix4(this.s.groups[g].transform);
   }
 
-  // The gizmo sits at the pivot (the Move tool, a movable active group); `reveal`: the view pans
-  // if the pivot is out of view or under the messages.
-  placeGizmo(reveal = false): void {
+  // The gizmo sits at the pivot (the Move tool, a movable active group). The view stays where it
+  // is (F or numpad . frames the group): it moves only when asked.
+  placeGizmo(): void {
     const v = this.s.viewer;
     const group = this.s.groups[this.s.activeGroup];
     const at = this.tool === 'move' && group && !group.pinned && this.s.editable && !this.drag?.modal ? this.pivotPoint() : null;
@@ -468,16 +477,7 @@ export class Interaction {
     v.pivot.scale.set(1, 1, 1);
     v.pivot.updateMatrix();
     v.gizmo.attach(v.pivot);
-    if (reveal) v.keepInView(at, this.clearArea());
     v.requestRender();
-  }
-
-  // The part of the view that no overlay covers, less the gizmo's reach.
-  private clearArea(): DOMRect {
-    const r = this.s.viewer.canvas.getBoundingClientRect();
-    const overlay = document.getElementById('overlay')!.getBoundingClientRect();
-    const top = Math.max(r.top, overlay.bottom) + 90;
-    return new DOMRect(r.left + 110, top, Math.max(0, r.width - 220), Math.max(0, r.bottom - 120 - top));
   }
 
   // Whether a press goes to the gizmo: one of its parts is under the pointer, but not an arrow
@@ -624,8 +624,9 @@ export class Interaction {
   }
 
   // L: the piece under the pointer; invert: the tool's label and the free vertices swap;
-  // grow / shrink: by one ring of neighbours. One undo step each.
-  selectTopology(op: 'linked' | 'invert' | 'grow' | 'shrink'): void {
+  // grow / shrink: by one ring of neighbours; all / none (A, Alt+A): every vertex gets the tool's
+  // label / the tool's label is cleared. One undo step each.
+  selectTopology(op: 'linked' | 'invert' | 'grow' | 'shrink' | 'all' | 'none'): void {
     const s = this.s;
     if (!s.paintable || this.stroke || this.drag) return;
     const label = this.toolLabel();
@@ -636,6 +637,12 @@ export class Interaction {
       const hit = s.viewer.pick(this.pointer.x, this.pointer.y);
       if (!hit) return s.note('missed the model: L selects the piece under the pointer');
       targets = Array.from(this.graph.linked(hit.vertex), (v) => v);
+    } else if (op === 'all') {
+      targets = Array.from(labels.keys());
+    } else if (op === 'none') {
+      if (label === FREE) return s.note('Alt+A clears the tool\'s label: pick Handle or Fixed');
+      targets = [];
+      labels.forEach((l, v) => l === label && targets.push(v));
     } else if (op === 'invert') {
       if (label === FREE) return s.note('invert swaps the tool\'s label with the free vertices: pick Handle or Fixed');
       targets = [];
@@ -644,7 +651,8 @@ export class Interaction {
       const inside = (v: number) => labels[v] === label;
       targets = this.graph.ring(inside, op === 'grow');
     }
-    this.relabel(targets, (l) => (op === 'invert' ? (l === label ? FREE : label) : op === 'shrink' ? FREE : label), label);
+    const freed = op === 'shrink' || op === 'none';
+    this.relabel(targets, (l) => (op === 'invert' ? (l === label ? FREE : label) : freed ? FREE : label), label);
   }
 
   // Gives each of `targets` its new label (pins stay unless erased): one undo step.

@@ -46,6 +46,7 @@ const viewer = state.viewer;
   transforms: () => state.groups.map((g) => rowMajor(g.transform)),
   vertexOnScreen: (v: number) => viewer.toScreen(new THREE.Vector3().fromArray(viewer.positions(), 3 * v)),
   diagonal: () => state.diagonal,
+  tool: () => interaction.tool,
   settled: () => state.settled(),
   previewSize: () => (state.previewWanted ? viewer.previewSize : 0),
   notes: () => state.notes.map((n) => ({ ...n })),

@@ -7,6 +7,7 @@ import * as THREE from 'three';
 import * as P from './protocol';
 import type { Mode } from './transform';
 import { EditorState, GROUP_HEX, PIN_HEX, stats } from './state';
+import type { Navigation } from './viewer';
 
 const $ = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
 
@@ -19,6 +20,19 @@ const HINTS: Record<Tool, string> = {
 };
 
 const MESH_FILE = /\.(obj|off|ply|stl|gltf|glb)$/i;
+const NAVIGATION_KEY = 'specdeform.navigation';
+
+// Keys typed into a text field (or a menu) stay there; every other control hands the keyboard back
+// to the view once used, so that a key acts whatever was clicked last, as in Blender.
+const TEXT_INPUTS = new Set(['text', 'number', 'search', 'email', 'password', 'url', 'tel']);
+const typing = (t: EventTarget | null): boolean =>
+  t instanceof HTMLTextAreaElement || t instanceof HTMLSelectElement ||
+  (t instanceof HTMLInputElement && TEXT_INPUTS.has(t.type));
+function releaseFocus(e: Event): void {
+  const t = e.target;
+  if (t instanceof HTMLElement && t !== document.body && !typing(t)) t.blur();
+  else if (e.type === 'change' && t instanceof HTMLSelectElement) t.blur();
+}
 
 // A loading stage, with its fraction when it has one (a stage without one is reported as 1).
 function progressText(phase: { stage: string; fraction: number }): string {
@@ -94,6 +108,13 @@ export class Panel {
     fileInput('open-selection', P.Tag.SelectionFile, 'load selection', 'Loading a selection');
     fileInput('open-scene', P.Tag.SceneFile, 'open scene', 'Opening a scene');
     $('wireframe').addEventListener('change', (e) => s.viewer.setWireframe((e.target as HTMLInputElement).checked));
+    this.navigation(JSON.parse(localStorage.getItem(NAVIGATION_KEY) ?? 'null') ?? { scheme: 'blender', emulate3: false });
+    const navigationChanged = () => this.navigation({
+      scheme: $<HTMLSelectElement>('navigation').value as Navigation,
+      emulate3: $<HTMLInputElement>('emulate3').checked,
+    }, true);
+    $('navigation').addEventListener('change', navigationChanged);
+    $('emulate3').addEventListener('change', navigationChanged);
     $('show-look').addEventListener('change', (e) => s.viewer.showLook((e.target as HTMLInputElement).checked));
     $('show-base').addEventListener('change', (e) =>
       s.request({ type: 'settings', view: (e.target as HTMLInputElement).checked ? 'base' : 'detailed' }, 'view', 'ready'));
@@ -132,7 +153,7 @@ export class Panel {
     }
     $('group').addEventListener('change', (e) => {
       s.activeGroup = Number((e.target as HTMLSelectElement).value);
-      this.ui.placeGizmo(true);
+      this.ui.placeGizmo();
       this.render();
     });
     $('new-group').addEventListener('click', () => {
@@ -183,6 +204,8 @@ export class Panel {
     };
     $('export-scene').addEventListener('click', () => s.request({ type: 'export_scene' }, 'export scene', 'file'));
 
+    document.addEventListener('change', releaseFocus);
+    document.addEventListener('click', releaseFocus);
     window.addEventListener('keydown', (e) => this.key(e));
     window.addEventListener('keyup', (e) => this.ui.modalKeyUp(e));
     window.addEventListener('dragover', (e) => {
@@ -225,6 +248,19 @@ export class Panel {
     }
   }
 
+  // How the mouse moves the view, kept in this browser.
+  private navigation(n: { scheme: Navigation; emulate3: boolean }, save = false): void {
+    const scheme: Navigation = n.scheme === 'right' ? 'right' : 'blender';
+    this.s.viewer.setNavigation(scheme);
+    this.ui.emulate3 = n.emulate3 === true;
+    $<HTMLSelectElement>('navigation').value = scheme;
+    $<HTMLInputElement>('emulate3').checked = this.ui.emulate3;
+    $('help-navigation').textContent = scheme === 'blender'
+      ? `Middle-drag: orbit · Shift+middle: pan · Ctrl+middle: zoom${this.ui.emulate3 ? ' (Alt+left: middle)' : ''}`
+      : 'Right-drag or Alt+drag: orbit · middle or Shift+right-drag: pan';
+    if (save) localStorage.setItem(NAVIGATION_KEY, JSON.stringify({ scheme, emulate3: this.ui.emulate3 }));
+  }
+
   private undo(redo: boolean): void {
     const s = this.s;
     if (!s.editable) return;
@@ -235,8 +271,7 @@ export class Panel {
   // The key map (docs/editor.md): digits pick tools, the numeric keypad's 1, 3, 7 (Ctrl: the
   // opposite side) look along the axes, as in Blender.
   private key(e: KeyboardEvent): void {
-    const target = e.target as HTMLElement;
-    if (target instanceof HTMLInputElement || target instanceof HTMLSelectElement || target instanceof HTMLTextAreaElement) return;
+    if (typing(e.target)) return;
     if ($<HTMLDialogElement>('confirm').open) return;
     if (this.ui.modalKey(e)) return e.preventDefault();
     const key = e.key.toLowerCase();
@@ -272,6 +307,12 @@ export class Panel {
       this.ui.selectTopology('shrink');
     } else if (e.altKey && key === 'z') {
       $<HTMLInputElement>('xray').click();
+    } else if (e.altKey && key === 'a') {
+      e.preventDefault();
+      this.ui.selectTopology('none');
+    } else if (e.key === 'Tab' && !ctrl && !e.altKey) {
+      e.preventDefault(); // as Blender's Tab: between painting and moving
+      this.ui.setTool(this.ui.tool === 'move' ? this.ui.paintTool : 'move');
     } else if (e.key === 'Escape') {
       this.ui.cancel();
     } else if (e.key === 'Home') {
@@ -283,6 +324,7 @@ export class Panel {
       else if (key === 'n') $('new-group').click();
       else if (key === 'l') this.ui.selectTopology('linked');
       else if (key === 'b') this.ui.armBox();
+      else if (key === 'a') this.ui.selectTopology('all');
       else if (key === 'f') this.ui.frameSelection();
     }
   }

@@ -17,10 +17,13 @@ export interface Hit {
   vertex: number; // the hit triangle's corner nearest to the point
 }
 
+export type Navigation = 'blender' | 'right';
+
 export class Viewer {
   readonly renderer: THREE.WebGLRenderer;
   readonly camera = new THREE.PerspectiveCamera(40, 1, 0.01, 100);
   readonly orbit: OrbitControls;
+  navigation: Navigation = 'blender';
   readonly gizmo: TransformControls;
   readonly pivot = new THREE.Object3D(); // what the gizmo moves
   readonly look = new FileLook(); // the file's texture, colours and normals, when it has them
@@ -94,9 +97,7 @@ export class Viewer {
     container.append(this.previewLabel, this.axes);
 
     this.orbit = new OrbitControls(this.camera, this.renderer.domElement);
-    // The left button paints and drags; orbiting is on the right button (or Alt + left, which
-    // the interaction switches on), panning on the middle one or Shift + right.
-    this.orbit.mouseButtons = { LEFT: null, MIDDLE: THREE.MOUSE.PAN, RIGHT: THREE.MOUSE.ROTATE };
+    this.setNavigation('blender');
     this.orbit.zoomToCursor = true;
     this.orbit.addEventListener('change', () => this.requestRender());
     this.gizmo = new TransformControls(this.camera, this.renderer.domElement);
@@ -112,6 +113,15 @@ export class Viewer {
       this.bvh = MeshBVH.deserialize(e.data.bvh, this.geometry, { setIndex: false });
       this.bvhStale = true; // the positions may have moved since
     };
+  }
+
+  // The left button paints and drags. As Blender: the middle button orbits, with Shift pans,
+  // with Ctrl zooms (which the interaction switches at the press); "right": the right button
+  // orbits (Shift: pans), the middle one pans. OrbitControls pans a ROTATE button held with Shift.
+  setNavigation(scheme: Navigation): void {
+    this.navigation = scheme;
+    const { ROTATE, PAN } = THREE.MOUSE;
+    this.orbit.mouseButtons = scheme === 'blender' ? { LEFT: null, MIDDLE: ROTATE, RIGHT: null } : { LEFT: null, MIDDLE: PAN, RIGHT: ROTATE };
   }
 
   get canvas(): HTMLCanvasElement {
@@ -378,22 +388,6 @@ export class Viewer {
     this.camera.position.copy(this.orbit.target).add(d.normalize().multiplyScalar(distance));
     this.orbit.update();
     this.requestRender();
-  }
-
-  // Pans (without turning) so that `point` lies in the part of the view that `clear` allows
-  // (client coordinates); returns whether it moved.
-  keepInView(point: THREE.Vector3, clear: DOMRect): boolean {
-    const s = this.toScreen(point);
-    if (s.x >= clear.left && s.x <= clear.right && s.y >= clear.top && s.y <= clear.bottom) return false;
-    const a = this.onViewPlane(s.x, s.y, point);
-    const b = this.onViewPlane(clear.left + clear.width / 2, clear.top + clear.height / 2, point);
-    if (!a || !b) return false;
-    const shift = a.sub(b);
-    this.camera.position.add(shift);
-    this.orbit.target.add(shift);
-    this.orbit.update();
-    this.requestRender();
-    return true;
   }
 
   resetCamera(): void {

@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# The Debian package (issue 45): `cpack -G DEB` makes it from the build; its dependencies name
+# Debian's packages (dpkg-shlibdeps); unpacked (dpkg-deb -x, as apt would lay it out under /), its
+# program runs `demo` from another folder, Debian's python3 imports its module, and Debian's
+# Blender lists its add-on, which loads that module.
+# Usage: deb_test.sh BUILD_DIR WORK_DIR [BLENDER]
+set -euo pipefail
+build=$1 work=$2 blender=${3:-}
+rm -rf "$work" && mkdir -p "$work"
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+echo "-- cpack"
+(cd "$build" && cpack -G DEB -B "$work" >/dev/null) || fail "cpack"
+deb=$(ls "$work"/specdeform_*_amd64.deb) || fail "no .deb"
+depends=$(dpkg-deb -f "$deb" Depends)
+echo "Depends: $depends"
+for package in libcholmod3 libopenblas0 libtinygltf2d libzip4 python3-numpy; do
+  [[ $depends == *"$package"* ]] || fail "Depends lacks $package"
+done
+
+echo "-- unpacked"
+root="$work/root"
+dpkg-deb -x "$deb" "$root"
+for f in usr/bin/specdeform usr/share/specdeform/web/index.html usr/lib/libspecdeform.a \
+         usr/lib/cmake/specdeform/specdeformConfig.cmake \
+         usr/share/blender/scripts/addons/specdeform_blender/__init__.py; do
+  [ -e "$root/$f" ] || fail "$f is not in the package"
+done
+[ ! -e "$root/usr/share/blender/scripts/addons/specdeform_blender/lib" ] ||
+  fail "the package's add-on carries its own module"
+mkdir -p "$work/elsewhere"
+cd "$work/elsewhere"
+"$root/usr/bin/specdeform" demo -o demo >/dev/null || fail "demo"
+[ -s demo/4_deformed.obj ] || fail "demo wrote no result"
+site="$root/usr/lib/python3/dist-packages"
+PYTHONPATH="$site" /usr/bin/python3 -c "
+import specdeform, sys
+assert specdeform.__file__.startswith(sys.argv[1]), specdeform.__file__
+V, F = specdeform.bumpy_bar()
+print('python3 imports', specdeform.__file__)" "$site" || fail "import specdeform"
+
+if [ -n "$blender" ]; then
+  # Debian's Blender reads its system add-ons from /usr/share/blender/scripts/addons only: the
+  # unpacked folder is shown to it as a user scripts folder.
+  mkdir -p "$work/user_scripts"
+  ln -s "$root/usr/share/blender/scripts/addons" "$work/user_scripts/addons"
+  PYTHONPATH="$site" BLENDER_USER_SCRIPTS="$work/user_scripts" \
+  "$blender" -b --factory-startup --python-exit-code 1 --python-expr "
+import addon_utils, sys
+addon_utils.enable('specdeform_blender', default_set=True, handle_error=None)
+library = sys.modules['specdeform_blender.library']
+assert library.specdeform is not None, library.problem
+assert library.specdeform.__file__.startswith('$site'), library.specdeform.__file__
+print('blender loads the add-on with', library.specdeform.__file__)
+" 2>&1 | grep -E "blender loads|Error|error" || fail "the add-on in Blender"
+fi
