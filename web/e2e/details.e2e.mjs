@@ -166,6 +166,7 @@ try {
   for (const page of browser.contexts().flatMap((c) => c.pages())) {
     await page.screenshot({ path: resolve(args.out, 'failure.png') }).catch(() => {});
     log('page notes:', JSON.stringify(await page.evaluate(() => window.specdeformEditor?.notes()).catch(() => null)));
+    log('page waits for:', JSON.stringify(await page.evaluate(() => window.specdeformEditor?.unsettled()).catch(() => null)));
   }
   throw e;
 } finally {

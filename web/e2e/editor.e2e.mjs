@@ -347,10 +347,13 @@ try {
     check(/Disconnected/.test(banner.text) && banner.top >= 0, `a banner says the page is disconnected (${banner.text})`);
     check(await page.$eval('#export-mesh', (b) => b.disabled), 'Export is disabled while disconnected');
     check(await page.$eval('#gizmo-rotate', (b) => b.disabled), 'the transform tools are disabled while disconnected');
+    await page.keyboard.press('g'); // a key while disconnected: says why it does nothing
     editor = startEditor(args.binary, meshArgs, port);
     await editor.url;
     await page.waitForSelector('#banner', { state: 'hidden', timeout: 60000 });
     await waitReady();
+    const stale = await page.$$eval('#notes .note', (ns) => ns.map((n) => n.textContent).filter((t) => /disconnected/.test(t)));
+    check(stale.length === 0, `reconnected, the messages raised while disconnected are gone (${stale})`);
     await page.waitForFunction(() => window.specdeformEditor.settled() && document.querySelector('#detail').value === 'displacement',
       null, { timeout: 120000 });
     const restored = await snapshot();
@@ -384,7 +387,46 @@ try {
     const shown = await page.$$eval('#notes .note', (els) => els.map((e) => e.textContent));
     check(!shown.some((t) => /sending/.test(t)), `the "sending" note is gone once the mesh is open (${JSON.stringify(shown)})`);
 
+    await paintedWhileComputing();
     await texturedFiles();
+  }
+
+  // A stroke painted while a mesh's basis is computed, then the page reloaded (still computing):
+  // the stroke is back, and the server has it once the mesh is ready; likewise in a second window.
+  async function paintedWhileComputing() {
+    log('painted while the basis computes, reloaded');
+    const plane = resolve(args.out, 'plane.obj');
+    execFileSync(args.binary, ['generate', 'bumpy-plane', '--resolution', '400', '-o', plane]);
+    await page.setInputFiles('#open-mesh', plane);
+    if (await page.$('#confirm[open]')) await page.click('#confirm-yes');
+    // The mesh is shown (its name only once it is ready).
+    const loading = () => window.specdeformEditor.phase === 'loading' && window.specdeformEditor.paintable &&
+      window.specdeformEditor.vertices() === 401 * 401;
+    await page.waitForFunction(loading, null, { timeout: 60000 });
+    await page.click('[data-tool="handle"]');
+    const middle = await page.$eval('#view canvas', (c) => { const r = c.getBoundingClientRect(); return { x: r.left + r.width / 2, y: r.top + r.height / 2 }; });
+    await page.mouse.move(middle.x, middle.y);
+    await page.mouse.down();
+    await page.mouse.move(middle.x + 30, middle.y, { steps: 3 });
+    await page.mouse.up();
+    await page.waitForFunction(() => window.specdeformEditor.counts().handles > 0, null, { timeout: 30000 });
+    const painted = await api(() => ({ labels: window.specdeformEditor.labels(), phase: window.specdeformEditor.phase }));
+    const handles = painted.labels.filter((l) => l === 2).length;
+    log(`${handles} handle vertices painted, phase ${painted.phase}`);
+    check(painted.phase === 'loading', `the stroke was painted while the basis computed (${painted.phase})`);
+    // A second window takes the session over; then the first, reloaded, takes it back.
+    const [second] = await Promise.all([page.waitForEvent('popup'), page.evaluate((u) => window.open(u), page.url())]);
+    const keeps = async (p, name) => {
+      await p.waitForFunction((n) => window.specdeformEditor?.vertices() === n, painted.labels.length, { timeout: 60000 });
+      const back = await p.evaluate(() => window.specdeformEditor.labels());
+      check(JSON.stringify(back) === JSON.stringify(painted.labels), `${name} shows the stroke painted while the basis computed`);
+    };
+    await keeps(second, 'a second window');
+    await second.close();
+    await page.reload();
+    await keeps(page, 'the first, reloaded,');
+    await waitReady(120000);
+    await page.waitForFunction((h) => window.specdeformEditor.serverCounts()?.handles === h, handles, { timeout: 60000 });
   }
 
   // A textured .glb: drawn with its image, a painted handle visible over it; exported as
@@ -775,6 +817,37 @@ try {
     const other = await api(() => window.specdeformEditor.transforms()[1]);
     check(other.every((x, i) => Math.abs(x - [1, 0, 0, -step, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1][i]) < 1e-12 * r.diagonal),
       `the mirrored group moves by the mirrored G X ${step} (${other})`);
+    // A box on one side, with X mirror: its vertices and their counterparts.
+    await page.click('#clear');
+    await waitReady(60000);
+    // Around a vertex in view a tenth of the diagonal on the low side of the plane.
+    const spot = await api((x) => {
+      const e = window.specdeformEditor;
+      const p = e.restPositions();
+      const rect = document.querySelector('#view canvas').getBoundingClientRect();
+      for (let v = 0; v < p.length / 3; ++v) {
+        const s = p[3 * v] < x && e.vertexOnScreen(v);
+        if (s && s.x > rect.left + 60 && s.x < rect.right - 60 && s.y > rect.top + 150 && s.y < rect.bottom - 80) return s;
+      }
+      return null;
+    }, plane - 0.1 * r.diagonal);
+    check(spot !== null, 'a vertex on one side is in view');
+    await keys('2', 'b');
+    await page.mouse.move(spot.x - 30, spot.y - 30);
+    await page.mouse.down();
+    await page.mouse.move(spot.x + 30, spot.y + 30, { steps: 4 });
+    await page.mouse.up();
+    await waitReady(60000);
+    r = await result();
+    const boxed = side(1);
+    const fixedKeys = new Set(boxed.map((v) => key(v, false)));
+    const [west, east] = [boxed.filter((v) => r.rest[3 * v] < plane).length, boxed.filter((v) => r.rest[3 * v] > plane).length];
+    const unpaired = (await api(() => window.specdeformEditor.notes())).some((n) => /no counterpart/.test(n.text));
+    log(`box with X mirror: ${west} and ${east} vertices on either side${unpaired ? ', some unpaired (said)' : ''}`);
+    check(west > 0 && (east > 0 || unpaired), `a box on one side with X mirror selects the other side (${west}, ${east})`);
+    if (!args.mesh) {
+      check(west === east && boxed.every((v) => fixedKeys.has(key(v, true))), 'the two sides are each other\'s mirror images');
+    }
     await page.uncheck('#x-mirror');
 
     log('navigation');
@@ -822,6 +895,7 @@ try {
     await page.screenshot({ path: resolve(args.out, 'failure.png') }).catch(() => {});
     const notes = await page.evaluate(() => window.specdeformEditor?.notes()).catch(() => null);
     log('page notes:', JSON.stringify(notes));
+    log('page waits for:', JSON.stringify(await page.evaluate(() => window.specdeformEditor?.unsettled()).catch(() => null)));
   }
   throw e;
 } finally {

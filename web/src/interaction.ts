@@ -171,7 +171,7 @@ export class Interaction {
         this.s.activeGroup = this.newGroup(false);
         label = 2 + this.s.activeGroup;
       }
-      this.stroke = { before: this.s.labels.slice(), touched: new Set(), label, pin };
+      this.stroke = { before: this.s.labels.slice(), touched: new Set(), label, pin, unpaired: 0 };
       this.s.painting = true;
       this.paintAt(e.clientX, e.clientY);
     }
@@ -256,8 +256,10 @@ export class Interaction {
       // Painted into the stroke that asked, which may have ended and another begun meanwhile.
       const labels = this.s.labels;
       const changed: number[] = [];
-      const paired = this.xMirror.on && stroke.pin === null ? this.xMirror.paired(this.s, vertices, stroke.label) : [];
-      for (const [v, label] of stroke.cancelled ? [] : [...Array.from(vertices, (v) => [v, stroke.label]), ...paired]) {
+      const { pairs, unpaired } = this.xMirror.on && stroke.pin === null && !stroke.cancelled
+        ? this.xMirror.paired(this.s, vertices, stroke.label) : { pairs: [], unpaired: 0 };
+      stroke.unpaired += unpaired;
+      for (const [v, label] of stroke.cancelled ? [] : [...Array.from(vertices, (v) => [v, stroke.label]), ...pairs]) {
         // A pin stroke claims free, fixed and handle vertices; other tools leave pins alone
         // except Erase.
         const l = labels[v];
@@ -310,6 +312,7 @@ export class Interaction {
       return this.s.changed();
     }
     this.s.sendSelection(stroke.pin !== null ? new Set([stroke.pin]) : new Set());
+    this.noteUnpaired(stroke.unpaired);
     if (stroke.label >= 2 && stroke.pin === null && this.oneSided(stroke.label)) {
       this.s.note('the handle covers only the side facing you: its centre is on the surface, not in the part, so turns ' +
         'and scales shift it. Paint through with X-ray (Alt+Z, then B for a box), or orbit and paint around');
@@ -610,7 +613,7 @@ export class Interaction {
       this.s.note('Pin paints one pinned region per stroke: pick Handle, Fixed or Erase');
       return true;
     }
-    this.relabel(verticesIn(this.s.viewer, contains, this.xray, this.s.diagonal), () => label, label);
+    this.relabel(verticesIn(this.s.viewer, contains, this.xray, this.s.diagonal), () => label);
     return true;
   }
 
@@ -652,28 +655,55 @@ export class Interaction {
       targets = this.graph.ring(inside, op === 'grow');
     }
     const freed = op === 'shrink' || op === 'none';
-    this.relabel(targets, (l) => (op === 'invert' ? (l === label ? FREE : label) : freed ? FREE : label), label);
+    // All, none and invert treat both sides alike already: X mirror has nothing to add.
+    const mirror = op === 'linked' || op === 'grow' || op === 'shrink';
+    this.relabel(targets, (l) => (op === 'invert' ? (l === label ? FREE : label) : freed ? FREE : label), mirror);
   }
 
-  // Gives each of `targets` its new label (pins stay unless erased): one undo step.
-  private relabel(targets: number[], next: (label: number) => number, label: number): void {
+  // Gives each of `targets` its new label (pins stay unless erased), and with X mirror (`mirror`)
+  // each counterpart outside the targets the mirror of it: one undo step.
+  private relabel(targets: number[], next: (label: number) => number, mirror = true): void {
     const s = this.s;
     const labels = s.labels;
     const changed: number[] = [];
-    for (const v of targets) {
+    const set = (v: number, to: number) => {
       const l = labels[v];
-      if (l >= 2 && s.groups[l - 2]?.pinned && label !== FREE) continue;
-      const to = next(l);
+      if (l >= 2 && s.groups[l - 2]?.pinned && to !== FREE) return;
       if (l !== to) {
         labels[v] = to;
         changed.push(v);
       }
+    };
+    for (const v of targets) set(v, next(labels[v]));
+    if (mirror && this.xMirror.on) {
+      // Each changed vertex's counterpart takes the mirror of its new label.
+      const chosen = new Set(targets);
+      const byLabel = new Map<number, number[]>();
+      for (const v of changed) {
+        const list = byLabel.get(labels[v]);
+        if (list) list.push(v);
+        else byLabel.set(labels[v], [v]);
+      }
+      let unpaired = 0;
+      for (const [to, vertices] of byLabel) {
+        const mirrored = this.xMirror.paired(s, vertices, to);
+        unpaired += mirrored.unpaired;
+        for (const [w, l] of mirrored.pairs) if (!chosen.has(w)) set(w, l);
+      }
+      this.noteUnpaired(unpaired);
     }
     if (changed.length === 0) return s.note('nothing changed');
     s.paint(changed);
     s.sendSelection();
     this.placeGizmo();
     s.changed();
+  }
+
+  private noteUnpaired(unpaired: number): void {
+    if (unpaired > 0) {
+      this.s.note(`X mirror: ${unpaired} of the vertices selected have no counterpart (no vertex within 2% of the ` +
+        'diagonal of their mirror image): the mesh is not symmetric there; they were selected alone');
+    }
   }
 
   // ------------------------------------------------------------ keyboard
@@ -721,6 +751,7 @@ interface Stroke {
   touched: Set<number>;
   label: number;
   pin: number | null; // the pinned group it paints, if a Pin stroke
+  unpaired: number; // brushed vertices X mirror found no counterpart for (counted per query)
   finishing?: boolean; // ended while a brush query was out
   cancelled?: boolean;
 }

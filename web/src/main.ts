@@ -41,6 +41,7 @@ const viewer = state.viewer;
   restPositions: () => Array.from(state.rest),
   positions: () => Array.from(viewer.positions()),
   labels: () => Array.from(state.labels),
+  vertices: () => state.labels.length, // of the mesh shown
   counts: () => state.counts(), // of the labels painted
   slowBrush: (ms: number) => (state.brushDelayMs = ms),
   transforms: () => state.groups.map((g) => rowMajor(g.transform)),
@@ -48,6 +49,7 @@ const viewer = state.viewer;
   diagonal: () => state.diagonal,
   tool: () => interaction.tool,
   settled: () => state.settled(),
+  unsettled: () => ({ phase: state.phase.kind, ready: state.editable, waits: state.unsettled() }),
   previewSize: () => (state.previewWanted ? viewer.previewSize : 0),
   notes: () => state.notes.map((n) => ({ ...n })),
   cameraPosition: () => viewer.camera.position.toArray(),

@@ -84,8 +84,9 @@ export class XMirror {
     return this.symmetry.mirror;
   }
 
-  // The counterparts of painted vertices with the label each gets.
-  paired(s: EditorState, vertices: Uint32Array, label: number): [number, number][] {
+  // The counterparts of painted vertices with the label each gets, and how many have none (no
+  // vertex within 2% of the diagonal of their mirror image).
+  paired(s: EditorState, vertices: ArrayLike<number>, label: number): { pairs: [number, number][]; unpaired: number } {
     const m = this.mirrorOf(s);
     let target = label;
     if (label >= 2) {
@@ -100,9 +101,14 @@ export class XMirror {
       }
       target = 2 + p;
     }
-    const out: [number, number][] = [];
-    for (const v of vertices) if (m.of[v] >= 0 && m.of[v] !== v) out.push([m.of[v], target]);
-    return out;
+    const pairs: [number, number][] = [];
+    let unpaired = 0;
+    for (let i = 0; i < vertices.length; ++i) {
+      const v = vertices[i];
+      if (m.of[v] < 0) ++unpaired;
+      else if (m.of[v] !== v) pairs.push([m.of[v], target]);
+    }
+    return { pairs, unpaired };
   }
 
   // Group g's counterpart takes the mirror image of its transform.

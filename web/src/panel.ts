@@ -44,6 +44,7 @@ export class Panel {
   private lastPhase = '';
   private mirrorMesh: string | null = null; // the mesh whose X-mirror pairing is in use
   private transientToasts: HTMLElement[] = []; // removed when the request ends
+  private offlineToasts: HTMLElement[] = []; // raised while disconnected: removed on reconnection
 
   constructor(private readonly s: EditorState, private readonly ui: Interaction) {
     s.subscribe(() => this.render());
@@ -418,6 +419,7 @@ export class Panel {
       $<HTMLInputElement>('x-mirror').checked = this.ui.xMirror.on;
     }
     if (phase.kind !== 'busy') this.transientToasts.splice(0).forEach((t) => t.remove());
+    if (connected) this.offlineToasts.splice(0).forEach((t) => t.remove());
     this.lastPhase = phase.kind;
     if (!connected || !editable) s.viewer.gizmo.detach();
     else if (this.ui.tool === 'move' && !s.viewer.gizmo.object) this.ui.placeGizmo();
@@ -486,6 +488,7 @@ export class Panel {
       notes.append(el);
       // Information fades; errors stay until dismissed.
       if (note.transient) this.transientToasts.push(el);
+      else if (note.offline) this.offlineToasts.push(el);
       else if (note.level === 'info') setTimeout(() => el.remove(), 6000);
       while (notes.children.length > 4) notes.firstElementChild!.remove();
       const li = document.createElement('li');
@@ -531,6 +534,10 @@ export class Panel {
     const now = performance.now();
     const lastSecond = stats.drawTimes.filter((t) => now - t < 1000).length;
     const median = (v: number[]) => (v.length ? [...v].sort((a, b) => a - b)[Math.floor(v.length / 2)] : NaN);
+    // The readouts of drawing say their age once nothing has been drawn for two seconds.
+    const last = stats.drawTimes.at(-1);
+    const idle = last === undefined ? 0 : (now - last) / 1000;
+    const age = idle < 2 ? '' : ` (last drawn ${idle < 60 ? `${idle.toFixed(0)} s` : `${(idle / 60).toFixed(0)} min`} ago)`;
     const rows: [string, string][] = [
       ['basis', r ? `${r.basis.seconds.toFixed(2)} s (${r.basis.source}, m = ${r.modes}${
         r.basis.approximate ? `, approximate: multilevel; its modes are only close to the true frequencies ` +
@@ -542,8 +549,8 @@ export class Panel {
           f.foldZone ? ' (the smooth base folded: details added as displacements there)' : ''}` : '–'],
       ['ARAP iterations', r?.settings.energy === 'arap' && f
         ? `${f.arap.iterations}${f.arap.converged ? '' : ' (not converged)'} · ${r.arap_clusters} clusters` : '–'],
-      ['drag → drawn (median)', stats.latencies.length ? `${median(stats.latencies.slice(-30)).toFixed(0)} ms` : '–'],
-      ['updates drawn per second', `${lastSecond}`],
+      ['drag → drawn (median)', stats.latencies.length ? `${median(stats.latencies.slice(-30)).toFixed(0)} ms${age}` : '–'],
+      ['updates drawn per second', `${lastSecond}${age}`],
       ['full draw / preview', s.drawMs ? `${s.drawMs.toFixed(0)} ms / ${s.previewWanted ? `${s.viewer.previewSize.toLocaleString()} vertices` : 'off'}` : '–'],
       ['smooth base misses the handles by', f ? `${(100 * f.error.max).toPrecision(2)}% of the diagonal` : '–'],
     ];

@@ -8,6 +8,7 @@ import type { Slot, WorkerReply, WorkerRequest } from './geometry.worker';
 import type { Measures } from './measures';
 import * as P from './protocol';
 import { Viewer } from './viewer';
+import { dropHeld, loadHeld, meshKey, saveHeld } from './held';
 
 // Per-vertex labels: 0 free, 1 fixed, 2 + g handle group g.
 export const FREE = 0;
@@ -27,7 +28,8 @@ export interface Group {
 }
 
 // `transient`: true while it holds (a file being sent), gone when the request ends.
-export type Note = { text: string; level: 'info' | 'error'; time: number; transient: boolean };
+// `offline`: raised while not connected (its message leaves the view on reconnection).
+export type Note = { text: string; level: 'info' | 'error'; time: number; transient: boolean; offline: boolean };
 
 // Drawing and response statistics (the timings panel and the end-to-end test).
 export const stats = {
@@ -71,6 +73,7 @@ export class EditorState {
   preparing = false;
   saving: string | null = null; // the basis file the server writes in the background
   private selectionHeld = false; // painted while preparing: sent when the mesh is ready
+  private heldKey = ''; // the mesh's name in local storage (held.ts)
   private firstDraw: 'none' | 'shown' | 'drawn' = 'drawn'; // of a new mesh
   previewWanted = false;
   private preview: P.PreviewMessage | null = null; // the coarse mesh of drags
@@ -136,7 +139,7 @@ export class EditorState {
     if (!text) return;
     // Bytes of a garbage file quoted by the server's reader show as one '?' per run.
     text = text.replace(/[\u0000-\u0008\u000b-\u001f\u007f-\u009f\ufffd]+/g, '?');
-    this.notes.push({ text, level, time: Date.now(), transient });
+    this.notes.push({ text, level, time: Date.now(), transient, offline: !this.connection.open });
     if (this.notes.length > 30) this.notes.shift();
     this.changed();
   }
@@ -163,6 +166,7 @@ export class EditorState {
   sendSelection(fit: Set<number> = new Set(), echo = false): void {
     if (this.preparing) {
       this.selectionHeld = true;
+      saveHeld(this.heldKey, this.labels, this.groups);
       return;
     }
     if (fit.size === 0 && !echo && this.selectionsInFlight > 0) {
@@ -246,9 +250,19 @@ export class EditorState {
   }
 
   settled(): boolean {
-    return this.outstanding === null && this.pendingDraw === null && this.awaitingStates === 0 &&
-      !this.selectionWaiting && !this.server?.detail_pending && !this.painting &&
-      !this.normalsBusy.full && this.phase.kind !== 'busy' && !this.selectionHeld && this.selectionsInFlight === 0;
+    return this.unsettled().length === 0;
+  }
+
+  // What the page still waits for (automation's diagnostics).
+  unsettled(): string[] {
+    const waits: [boolean, string][] = [
+      [this.outstanding !== null, `frame ${this.outstanding}'s result`], [this.pendingDraw !== null, 'a frame to draw'],
+      [this.awaitingStates > 0, `${this.awaitingStates} states`], [this.selectionWaiting, 'a selection waiting'],
+      [!!this.server?.detail_pending, 'the detail'], [this.painting, 'a stroke'], [this.normalsBusy.full, 'normals'],
+      [this.phase.kind === 'busy', 'busy'], [this.selectionHeld, 'a held selection'],
+      [this.selectionsInFlight > 0, `${this.selectionsInFlight} selections in flight`],
+    ];
+    return waits.filter(([on]) => on).map(([, what]) => what);
   }
 
   // The vertices a brush stroke reaches (computed by the worker).
@@ -488,9 +502,25 @@ export class EditorState {
       this.selectionHeld = false;
       this.firstDraw = 'none';
       this.previewFrom = null;
+      this.heldKey = meshKey(this.rest, this.indices);
+      this.selectionHeld = this.adoptHeld();
       this.paint();
     }
   }
+
+  // The selection held for this mesh in local storage (a reload, another window), if newer than
+  // what is shown; returns whether there was one.
+  private adoptHeld(): boolean {
+    const held = loadHeld(this.heldKey, this.labels.length);
+    if (!held || held.time <= this.heldTime) return held !== null;
+    this.heldTime = held.time;
+    this.labels = held.labels;
+    this.groups = held.groups.map((g) => ({ transform: new THREE.Matrix4().fromArray(g.transform), pinned: g.pinned }));
+    this.activeGroup = Math.min(this.activeGroup, this.groups.length - 1);
+    this.paint();
+    return true;
+  }
+  private heldTime = 0;
 
   private adoptReady(m: P.ReadyMessage): void {
     const previous = this.ready;
@@ -574,7 +604,9 @@ export class EditorState {
     if (m.request === 'selection') this.selectionAnswered();
     if (this.selectionHeld && !this.preparing) {
       this.selectionHeld = false;
+      this.adoptHeld(); // another window's strokes since
       this.sendSelection();
+      dropHeld(this.heldKey);
     }
     if (!this.preparing) this.sendPreviewRequest();
     if (!this.restoreChecked) {
