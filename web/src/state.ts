@@ -503,6 +503,7 @@ export class EditorState {
       this.firstDraw = 'none';
       this.previewFrom = null;
       this.heldKey = meshKey(this.rest, this.indices);
+      this.heldTime = 0; // another mesh: any held selection of it is newer than none
       this.selectionHeld = this.adoptHeld();
       this.paint();
     }
