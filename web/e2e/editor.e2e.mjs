@@ -64,6 +64,9 @@ try {
     page.waitForFunction(() => window.specdeformEditor?.ready && window.specdeformEditor.settled(), null, { timeout });
   await waitReady();
   const api = (fn, arg) => page.evaluate(fn, arg);
+  // The key map's rows (keymap.ts) each test exercises: every one by the end.
+  const covered = new Set();
+  const cover = (...rows) => rows.forEach((row) => covered.add(row));
 
   // Every message over the viewport is in view without scrolling.
   const noteInView = async (pattern) => {
@@ -105,6 +108,7 @@ try {
     await page.keyboard.press('2');
     check((await page.inputValue('#modes')) === '50', `m is not typed into (${await page.inputValue('#modes')})`);
     check((await page.getAttribute('[data-tool="fixed"]', 'aria-checked')) === 'true', '"2" picked the Fixed tool');
+    cover('tools');
     await waitReady(120000); // Enter applied m = 50: a new basis
     check((await page.inputValue('#modes')) === '50', 'm = 50 was applied');
   }
@@ -162,6 +166,7 @@ try {
   const handles = labels.flatMap((l, v) => (l === 2 ? [v] : []));
   const fixed = labels.flatMap((l, v) => (l === 1 ? [v] : []));
   check(handles.length > 0 && fixed.length > 0, `brush selected ${handles.length} handle and ${fixed.length} fixed vertices`);
+  cover('paint');
 
   // Drag the handle up the screen, at about 60 mouse events per second.
   log('drag');
@@ -316,6 +321,7 @@ try {
     check((await restError()) < 1e-5, 'undo returns to the rest shape');
     await page.keyboard.press('Control+Shift+z');
     check((await restError()) > 0.02, 'redo deforms it again');
+    cover('undo');
 
     // A detail method from the panel: the server rebuilds and the frame comes back solved with it.
     await page.selectOption('#detail', 'displacement');
@@ -419,7 +425,9 @@ try {
     const keeps = async (p, name) => {
       await p.waitForFunction((n) => window.specdeformEditor?.vertices() === n, painted.labels.length, { timeout: 60000 });
       const back = await p.evaluate(() => window.specdeformEditor.labels());
-      check(JSON.stringify(back) === JSON.stringify(painted.labels), `${name} shows the stroke painted while the basis computed`);
+      const tally = (labels) => JSON.stringify(labels.reduce((t, l) => ({ ...t, [l]: (t[l] ?? 0) + 1 }), {}));
+      check(JSON.stringify(back) === JSON.stringify(painted.labels),
+        `${name} shows the stroke painted while the basis computed (labels ${tally(back)}, painted ${tally(painted.labels)})`);
     };
     await keeps(second, 'a second window');
     await second.close();
@@ -573,6 +581,7 @@ try {
     check((await transform())[7] === 5, 'G Y 5 moves while typed');
     await keys('Escape');
     check(JSON.stringify(await transform()) === JSON.stringify(moved), 'Esc cancels the move');
+    cover('modal', 'cancel');
     await keys('r', 'x', '4', '5');
     await page.mouse.click(canvas.x, canvas.y, { button: 'right' });
     check(JSON.stringify(await transform()) === JSON.stringify(moved), 'a right-click cancels the turn');
@@ -624,6 +633,7 @@ try {
     await page.keyboard.up('Shift');
     const cursor = await api(() => window.specdeformEditor.cursor());
     check(cursor !== null, 'Shift + right-click placed the 3D cursor');
+    cover('cursor');
     await page.selectOption('#pivot', 'cursor');
     await keys('r', 'z', '9', '0', 'Enter');
     r = await result();
@@ -634,7 +644,7 @@ try {
 
     // Individual pivots: a second group at the other end; R Z 90 turns each about its centroid.
     await page.selectOption('#pivot', 'individual');
-    await keys('n', 'Home'); // the first view again (numpad . framed the handle)
+    await keys('Shift+N', 'Home'); // the first view again (numpad . framed the handle)
     await dismiss();
     await click(ends.fixed);
     await keys('4', 'r', 'z', '9', '0', 'Enter');
@@ -691,6 +701,7 @@ try {
     await page.mouse.wheel(0, -100);
     await waitReady(60000);
     check(Number(await page.inputValue('#influence')) > 30, `the wheel widened the region (${await page.inputValue('#influence')}%)`);
+    cover('wheel');
     await keys('Escape');
     await page.fill('#influence', '0');
     await page.press('#influence', 'Enter');
@@ -711,6 +722,7 @@ try {
     check((await looking())[2] < -0.999, 'Ctrl + numpad 1 looks from the back');
     await keys('Numpad1');
     check((await looking())[2] > 0.999, 'numpad 1 looks from the front');
+    cover('views');
 
     log('select linked, invert, grow, shrink');
     const count = async (label) => (await api(() => window.specdeformEditor.labels())).filter((l) => l === label).length;
@@ -725,6 +737,7 @@ try {
     check((await count(2)) < grown, 'shrink takes one off');
     await undoTwice();
     check((await count(2)) === handles0, 'undo returns to the painted handle');
+    cover('grow');
     await keys('2');
     await keys('Home'); // the whole model, from the front: the middle of the view is on it
     await page.mouse.move(canvas.x, canvas.y);
@@ -732,11 +745,13 @@ try {
     await waitReady(60000);
     const linked = await count(1);
     check(linked > fixed.length, `L selects the piece under the pointer (${linked} fixed vertices)`);
+    cover('linked');
     await keys('Control+i');
     await waitReady(60000);
     check((await count(1)) === 0 || (await count(1)) < linked, 'invert swaps fixed and free');
     await undoTwice();
     check((await count(1)) === fixed.length, 'undo puts the fixed region back');
+    cover('invert');
     await page.click('#select-linked'); // the button: the next click picks the piece
     await page.mouse.click(canvas.x, canvas.y);
     await waitReady(60000);
@@ -756,10 +771,12 @@ try {
     check((await count(1)) === 0, `Alt+A: the fixed label cleared (${await count(1)})`);
     await undoTwice();
     check((await count(1)) === fixedBefore, `undone twice, the fixed part is back (${await count(1)} of ${fixedBefore})`);
+    cover('all');
     await keys('Tab');
     check((await api(() => window.specdeformEditor.tool())) === 'move', 'Tab: from painting to Move');
     await keys('Tab');
     check((await api(() => window.specdeformEditor.tool())) === 'fixed', 'Tab again: back to the tool that paints');
+    cover('tab');
 
     log('box and lasso select');
     const boxSelect = async (lasso = false) => {
@@ -792,6 +809,7 @@ try {
     log(`box: ${visible} visible, ${through} with X-ray; lasso: ${lassoed}`);
     check(lassoed > 0 && lassoed < visible, `the lasso (a diamond inside the box) selects fewer than the box (${lassoed})`);
     check(visible > 0 && through > 1.5 * visible, `a box selects the visible vertices (${visible}), with X-ray those behind too (${through})`);
+    cover('box');
 
     log('X mirror');
     await page.click('#clear');
@@ -887,6 +905,124 @@ try {
     check(JSON.parse(await page.evaluate(() => localStorage.getItem('specdeform.navigation'))).scheme === 'right',
       'the scheme is kept in the browser');
     await page.selectOption('#navigation', 'blender');
+    cover('orbit');
+    await moreKeys();
+  }
+
+  // N, Shift+N, H and Alt+H, the numpad's turns, framing, the key map's table (against
+  // docs/editor.md's), a missed press said at the pointer; then every row of the table covered.
+  async function moreKeys() {
+    const canvas = await page.$eval('#view canvas', (c) => { const r = c.getBoundingClientRect(); return { x: r.left + r.width / 2, y: r.top + r.height / 2 }; });
+    const keys = async (...sequence) => {
+      for (const k of sequence) await page.keyboard.press(k);
+    };
+    const camera = () => api(() => [window.specdeformEditor.cameraPosition(), window.specdeformEditor.cameraTarget()]);
+    const sub = (a, b) => a.map((x, i) => x - b[i]);
+    const unit = (a) => a.map((x) => x / Math.hypot(...a));
+    const dot = (a, b) => a.reduce((t, x, i) => t + x * b[i], 0);
+    const diagonal = await api(() => window.specdeformEditor.diagonal());
+    // The centre of the box around the vertices `want` picks, where they are drawn.
+    const centre = (want) => api((w) => {
+      const p = window.specdeformEditor.positions(), l = window.specdeformEditor.labels();
+      const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+      l.forEach((label, v) => {
+        if (w !== null && label !== w) return;
+        for (let k = 0; k < 3; ++k) [lo[k], hi[k]] = [Math.min(lo[k], p[3 * v + k]), Math.max(hi[k], p[3 * v + k])];
+      });
+      return lo.map((x, k) => (x + hi[k]) / 2);
+    }, want);
+
+    log('keys: frame, numpad turns');
+    await keys('1', 'Home');
+    let [p, t] = await camera();
+    check(Math.hypot(...sub(t, await centre(null))) < 1e-6 * diagonal, 'Home frames the whole mesh');
+    await page.click('#clear');
+    await waitReady(60000);
+    await keys('1');
+    await page.mouse.click(canvas.x, canvas.y); // a handle in the active group
+    await waitReady(60000);
+    await keys('f');
+    [p, t] = await camera();
+    const active = 2 + (await api(() => window.specdeformEditor.activeGroup()));
+    check(Math.hypot(...sub(t, await centre(active))) < 1e-6 * diagonal, `F frames the active group (${t})`);
+    cover('frame');
+    await keys('Home', 'Numpad1');
+    for (const [key, degrees] of [['Numpad6', 15], ['Numpad4', 15], ['Numpad8', 15], ['Numpad2', 15], ['Numpad9', 180]]) {
+      const [p0, t0] = await camera();
+      await keys(key);
+      const [p1, t1] = await camera();
+      const turned = Math.acos(Math.min(1, Math.max(-1, dot(unit(sub(p0, t0)), unit(sub(p1, t1)))))) * 180 / Math.PI;
+      const [moved, distance] = [Math.hypot(...sub(t0, t1)), Math.hypot(...sub(p1, t1)) / Math.hypot(...sub(p0, t0)) - 1];
+      check(Math.abs(turned - degrees) < 1e-6 && moved < 1e-9 * diagonal && Math.abs(distance) < 1e-9,
+        `${key} orbits by ${degrees} degrees about the target (${turned}; target moved ${moved}, distance changed by ${distance})`);
+    }
+    cover('views', 'turn');
+
+    log('keys: N, Shift+N');
+    const width = () => page.$eval('#view canvas', (c) => c.getBoundingClientRect().width);
+    const w0 = await width();
+    await keys('n');
+    await page.waitForFunction((w) => document.querySelector('#view canvas').getBoundingClientRect().width > w, w0);
+    check(await page.$eval('#panel', (e) => e.hidden), `N hides the panel; the view takes its width (${w0} to ${await width()})`);
+    await keys('n');
+    await page.waitForFunction((w) => document.querySelector('#view canvas').getBoundingClientRect().width === w, w0);
+    check(!(await page.$eval('#panel', (e) => e.hidden)), 'N again shows it');
+    const groups = await api(() => window.specdeformEditor.transforms().length);
+    await keys('Shift+N');
+    check((await api(() => window.specdeformEditor.transforms().length)) === groups + 1, 'Shift+N adds a handle group');
+    cover('panel', 'new-group');
+
+    log('keys: H, Alt+H');
+    await keys('2', 'Home', 'Numpad1');
+    const all = await api(() => window.specdeformEditor.drawnTriangles());
+    const rectangle = async (key) => {
+      await keys(key);
+      await page.mouse.move(canvas.x - 60, canvas.y - 40);
+      await page.mouse.down();
+      await page.mouse.move(canvas.x + 60, canvas.y + 40, { steps: 4 });
+      await page.mouse.up();
+    };
+    await rectangle('h');
+    const hidden = await api(() => window.specdeformEditor.hidden());
+    const shown = await api(() => window.specdeformEditor.drawnTriangles());
+    check(hidden.length > 0 && shown < all, `H and a rectangle hide its visible vertices and their triangles (${hidden.length} vertices, ${all - shown} triangles)`);
+    const before = await api(() => window.specdeformEditor.labels());
+    await rectangle('b'); // the same rectangle selects what was behind
+    await waitReady(60000);
+    const after = await api(() => window.specdeformEditor.labels());
+    const behind = after.filter((l, v) => l !== before[v]).length;
+    check(behind > 0 && hidden.every((v) => after[v] === before[v]),
+      `a box over the hidden part selects what lies behind it (${behind} vertices), none of the hidden ones`);
+    await keys('Control+z');
+    await waitReady(60000);
+    await keys('Alt+h');
+    check((await api(() => window.specdeformEditor.hidden())).length === 0 && (await api(() => window.specdeformEditor.drawnTriangles())) === all,
+      'Alt+H shows every triangle again');
+    cover('hide');
+
+    log('keys: a missed press said at the pointer');
+    // A point of the view beside the model, clear of the messages and the help line.
+    const miss = await api((c) => [[-300, 250], [300, 250], [-350, 0], [350, 0], [-300, -200], [300, -200]]
+      .map(([dx, dy]) => ({ x: c.x + dx, y: c.y + dy })).find((p) => !window.specdeformEditor.onModel(p.x, p.y)), canvas);
+    check(miss, 'a point of the view misses the model');
+    await page.mouse.click(miss.x, miss.y);
+    const tip = await page.$eval('#pointer-note', (e) => ({ hidden: e.hidden, text: e.textContent, ...e.getBoundingClientRect().toJSON() }));
+    check(!tip.hidden && /missed the model/.test(tip.text) && Math.hypot(tip.x - miss.x, tip.y - miss.y) < 40,
+      `a press beside the model says so at the pointer (${JSON.stringify(tip)})`);
+
+    log('keys: the table');
+    await keys('?');
+    const rows = await page.$$eval('#keymap tr', (trs) => trs.map((tr) => [tr.dataset.key, ...[...tr.cells].map((c) => c.textContent)]));
+    check(await page.$eval('#keymap', (e) => !e.hidden && e.getBoundingClientRect().height > 100), '? shows the key map');
+    await keys('Escape');
+    check(await page.$eval('#keymap', (e) => e.hidden), 'Esc closes it');
+    cover('help');
+    const table = readFileSync(resolve(here, '../../docs/editor.md'), 'utf8').split('## Key map')[1].split('| key | does |\n|---|---|\n')[1];
+    const docs = table.slice(0, table.indexOf('\n\n')).split('\n').map((line) => line.split(' | ').map((c) => c.replace(/^\| |\s*\|$/g, '')));
+    check(JSON.stringify(docs) === JSON.stringify(rows.map((r) => r.slice(1))),
+      `docs/editor.md's key map is the page's (${JSON.stringify(docs.find((d, i) => JSON.stringify(d) !== JSON.stringify(rows[i]?.slice(1))))})`);
+    const missing = rows.map((r) => r[0]).filter((id) => !covered.has(id));
+    check(missing.length === 0, `every row of the key map is tested (not: ${missing.join(', ')})`);
   }
   check(pageErrors.length === 0, `no page errors: ${pageErrors.join('; ')}`);
 } catch (e) {

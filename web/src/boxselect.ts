@@ -48,7 +48,9 @@ export function verticesIn(viewer: Viewer, contains: (x: number, y: number) => b
   const bounds = viewer.canvas.getBoundingClientRect();
   const v = new THREE.Vector3();
   const out: number[] = [];
+  const hidden = viewer.hidden;
   for (let k = 0; 3 * k < p.length; ++k) {
+    if (hidden?.[k]) continue;
     v.set(p[3 * k], p[3 * k + 1], p[3 * k + 2]).project(camera);
     if (v.z > 1) continue; // behind the camera
     const x = bounds.left + ((v.x + 1) / 2) * bounds.width;

@@ -19,6 +19,16 @@ export type PivotMode = 'median' | 'cursor' | 'individual';
 // is not asked for between them).
 const kRestMs = 200;
 
+// How long a missed press's note stays at the pointer (ms).
+const kPointerNoteMs = 1500;
+
+interface Region {
+  armed: boolean; // the next left drag draws it
+  lasso: boolean;
+  hide: boolean; // hides what it holds instead of selecting it (H)
+  path: Point[];
+}
+
 interface Drag {
   group: number;
   start: THREE.Vector3; // the handle point grabbed (mouse), the gizmo's start or the pivot (G, R, S)
@@ -45,8 +55,8 @@ export class Interaction {
   pivotMode: PivotMode = 'median';
   cursor: THREE.Vector3 | null = null; // the 3D cursor
   readonly xMirror = new XMirror();
-  // B arms a box (drawn with the left button); Ctrl + right-drag draws a lasso.
-  private region: { armed: boolean; lasso: boolean; path: Point[] } = { armed: false, lasso: false, path: [] };
+  // B arms a box (drawn with the left button), H a box that hides; Ctrl + right-drag draws a lasso.
+  private region: Region = { armed: false, lasso: false, hide: false, path: [] };
   xray = false; // box and lasso select through the surface
   private linkedArmed = false; // the Linked button: the next click picks the piece
 
@@ -123,7 +133,7 @@ export class Interaction {
     const lasso = e.button === 2 && e.ctrlKey && this.s.paintable;
     if (e.target === v.canvas && ((this.region.armed && e.button === 0) || lasso)) {
       e.stopPropagation();
-      this.region = { armed: true, lasso, path: [{ x: e.clientX, y: e.clientY }] };
+      this.region = { ...this.region, armed: true, lasso, hide: this.region.hide && !lasso, path: [{ x: e.clientX, y: e.clientY }] };
       this.view.setPointerCapture(e.pointerId);
       return;
     }
@@ -147,9 +157,9 @@ export class Interaction {
     if (this.tool === 'move') {
       const l = hit ? this.s.labels[hit.vertex] : FREE;
       if (!hit || l < 2 || this.s.groups[l - 2].pinned) {
-        this.s.note(hit ? 'press on a coloured handle to drag it, or use the gizmo'
+        this.missed(hit ? 'press on a coloured handle to drag it, or use the gizmo'
           : this.nearGizmo(e.clientX, e.clientY) ? 'missed the gizmo: press on one of its arrows, rings or boxes (or use G, R, S)'
-            : 'missed the model: press on a handle');
+            : 'missed the model: press on a handle', e);
         return;
       }
       this.s.activeGroup = l - 2;
@@ -159,7 +169,7 @@ export class Interaction {
     } else {
       if (!hit) {
         const orbit = this.s.viewer.navigation === 'blender' ? 'middle-drag orbits' : 'right-drag or Alt+drag orbits';
-        this.s.note(`missed the model: a stroke starts on the surface (${orbit})`);
+        this.missed(`missed the model: a stroke starts on the surface (${orbit})`, e);
         return;
       }
       let pin: number | null = null;
@@ -259,9 +269,11 @@ export class Interaction {
       const { pairs, unpaired } = this.xMirror.on && stroke.pin === null && !stroke.cancelled
         ? this.xMirror.paired(this.s, vertices, stroke.label) : { pairs: [], unpaired: 0 };
       stroke.unpaired += unpaired;
+      const hidden = this.s.viewer.hidden;
       for (const [v, label] of stroke.cancelled ? [] : [...Array.from(vertices, (v) => [v, stroke.label]), ...pairs]) {
         // A pin stroke claims free, fixed and handle vertices; other tools leave pins alone
-        // except Erase.
+        // except Erase. Hidden vertices keep their labels.
+        if (hidden?.[v]) continue;
         const l = labels[v];
         const isPin = l >= 2 && this.s.groups[l - 2]?.pinned;
         if (isPin && label !== FREE && l !== label) continue;
@@ -506,7 +518,7 @@ export class Interaction {
   // Shift + right-click on the surface: the 3D cursor goes there.
   private placeCursor(x: number, y: number): void {
     const hit = this.s.viewer.pick(x, y);
-    if (!hit) return this.s.note('missed the model: the 3D cursor goes on the surface');
+    if (!hit) return this.missed('missed the model: the 3D cursor goes on the surface', { clientX: x, clientY: y });
     this.cursor = hit.point;
     this.s.viewer.showCursor(hit.point);
     this.placeGizmo();
@@ -574,6 +586,20 @@ export class Interaction {
     this.dragged();
   }
 
+  // A press that found nothing to act on: said at the pointer (for a moment) and in the messages.
+  private missed(text: string, at: { clientX: number; clientY: number }): void {
+    this.s.note(text);
+    const tip = document.getElementById('pointer-note')!;
+    const view = this.view.getBoundingClientRect();
+    tip.textContent = text.split(':')[0];
+    tip.style.left = `${at.clientX - view.left + 14}px`;
+    tip.style.top = `${at.clientY - view.top + 14}px`;
+    tip.hidden = false;
+    clearTimeout(this.tipTimer);
+    this.tipTimer = window.setTimeout(() => (tip.hidden = true), kPointerNoteMs);
+  }
+  private tipTimer: number | undefined;
+
   private showHeader(text: string): void {
     const header = document.getElementById('header')!;
     header.textContent = text;
@@ -596,18 +622,48 @@ export class Interaction {
   // B: the next left drag draws a rectangle; its vertices get the tool's label.
   armBox(): void {
     if (!this.s.paintable || this.stroke || this.drag) return;
-    this.region = { armed: true, lasso: false, path: [] };
+    this.region = { armed: true, lasso: false, hide: false, path: [] };
     this.showHeader(`Box select (${this.xray ? 'X-ray: through the surface' : 'visible vertices only'}): ` +
       'drag a rectangle with the left button; Esc cancels');
+  }
+
+  // H: the next left drag draws a rectangle; its vertices (those seen, or with X-ray all) and
+  // their triangles are hidden, to paint what is behind them. Alt+H reveals them.
+  armHide(): void {
+    if (!this.s.ready || this.stroke || this.drag) return;
+    this.region = { armed: true, lasso: false, hide: true, path: [] };
+    this.showHeader(`Hide (${this.xray ? 'X-ray: through the surface' : 'visible vertices only'}): ` +
+      'drag a rectangle over what to hide; Esc cancels; Alt+H reveals');
+  }
+
+  reveal(): void {
+    const v = this.s.viewer;
+    if (v.hiddenCount === 0) return this.s.note('nothing is hidden');
+    const count = v.hiddenCount;
+    v.setHidden(null, true);
+    this.s.note(`${count.toLocaleString()} hidden vertices shown again`);
+    this.s.changed();
   }
 
   // Ends the box or lasso, selecting what `contains` (null: cancelled); returns whether one was on.
   private endRegion(contains: ((x: number, y: number) => boolean) | null): boolean {
     if (!this.region.armed) return false;
-    this.region = { armed: false, lasso: false, path: [] };
+    const hide = this.region.hide;
+    this.region = { armed: false, lasso: false, hide: false, path: [] };
     showRegion(this.view, null);
     this.showHeader('');
     if (!contains) return true;
+    if (hide) {
+      const vertices = verticesIn(this.s.viewer, contains, this.xray, this.s.diagonal);
+      if (vertices.length === 0) {
+        this.s.note('no vertex in the rectangle: nothing hidden');
+        return true;
+      }
+      const total = this.s.viewer.setHidden(vertices);
+      this.s.note(`${vertices.length.toLocaleString()} vertices hidden (${total.toLocaleString()} in all; Alt+H reveals them)`);
+      this.s.changed();
+      return true;
+    }
     const label = this.toolLabel();
     if (label === null) {
       this.s.note('Pin paints one pinned region per stroke: pick Handle, Fixed or Erase');
@@ -638,7 +694,7 @@ export class Interaction {
     let targets: number[];
     if (op === 'linked') {
       const hit = s.viewer.pick(this.pointer.x, this.pointer.y);
-      if (!hit) return s.note('missed the model: L selects the piece under the pointer');
+      if (!hit) return this.missed('missed the model: L selects the piece under the pointer', { clientX: this.pointer.x, clientY: this.pointer.y });
       targets = Array.from(this.graph.linked(hit.vertex), (v) => v);
     } else if (op === 'all') {
       targets = Array.from(labels.keys());
@@ -666,7 +722,9 @@ export class Interaction {
     const s = this.s;
     const labels = s.labels;
     const changed: number[] = [];
+    const hidden = s.viewer.hidden;
     const set = (v: number, to: number) => {
+      if (hidden?.[v]) return; // as Blender: hidden vertices are not selected
       const l = labels[v];
       if (l >= 2 && s.groups[l - 2]?.pinned && to !== FREE) return;
       if (l !== to) {

@@ -5,6 +5,7 @@
 // texture too: a label attribute replaces the material's colour), free vertices in the file's own.
 import * as THREE from 'three';
 import { Wrap, type AppearanceMessage, type MaterialLook } from './protocol';
+import { visibleTriangles } from './hide';
 
 type LookMaterial = THREE.MeshLambertMaterial | THREE.MeshBasicMaterial;
 
@@ -71,7 +72,6 @@ export class FileLook {
       return;
     }
     const R = a.vertex.length;
-    this.geometry.setIndex(new THREE.BufferAttribute(a.indices.slice(), 1));
     this.geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * R), 3));
     this.geometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(3 * R), 3));
     const color = new Float32Array(3 * R).fill(1);
@@ -88,10 +88,27 @@ export class FileLook {
       const material = m < M && a.materials[m].unlit ? new THREE.MeshBasicMaterial(options) : new THREE.MeshLambertMaterial(options);
       material.onBeforeCompile = drawLabels;
       this.materials.push(material);
-      const first = a.materialStart[m], count = a.materialStart[m + 1] - first;
-      if (count > 0) this.geometry.addGroup(3 * first, 3 * count, m);
     }
     this.mesh.material = this.materials;
+    this.setHidden(null);
+  }
+
+  // Leaves out the triangles with a hidden mesh vertex (Viewer.setHidden), material by material.
+  setHidden(hidden: Uint8Array | null): void {
+    const a = this.appearance;
+    if (!a) return;
+    const parts: Uint32Array[] = [];
+    this.geometry.clearGroups();
+    let start = 0;
+    for (let m = 0; m + 1 < a.materialStart.length; ++m) {
+      const part = visibleTriangles(a.indices.subarray(3 * a.materialStart[m], 3 * a.materialStart[m + 1]), hidden, a.vertex);
+      if (part.length > 0) this.geometry.addGroup(start, part.length, m);
+      parts.push(part);
+      start += part.length;
+    }
+    const index = new Uint32Array(start);
+    parts.reduce((at, part) => (index.set(part, at), at + part.length), 0);
+    this.geometry.setIndex(new THREE.BufferAttribute(index, 1));
   }
 
   // Material m's base colour image (v up, as the texture coordinates are), laid as it says.

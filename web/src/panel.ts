@@ -6,6 +6,7 @@ import { Interaction, PivotMode, Tool } from './interaction';
 import * as THREE from 'three';
 import * as P from './protocol';
 import type { Mode } from './transform';
+import { renderKeymap } from './keymap';
 import { EditorState, GROUP_HEX, PIN_HEX, stats } from './state';
 import type { Navigation } from './viewer';
 
@@ -21,6 +22,7 @@ const HINTS: Record<Tool, string> = {
 
 const MESH_FILE = /\.(obj|off|ply|stl|gltf|glb)$/i;
 const NAVIGATION_KEY = 'specdeform.navigation';
+const kOrbitStep = 15; // degrees a numpad 4, 6, 8 or 2 turns the view (Blender's default)
 
 // Keys typed into a text field (or a menu) stay there; every other control hands the keyboard back
 // to the view once used, so that a key acts whatever was clicked last, as in Blender.
@@ -205,6 +207,9 @@ export class Panel {
     };
     $('export-scene').addEventListener('click', () => s.request({ type: 'export_scene' }, 'export scene', 'file'));
 
+    renderKeymap($<HTMLTableElement>('keymap-table'));
+    $('keymap-close').addEventListener('click', () => this.toggleKeymap());
+    $('show-keymap').addEventListener('click', () => this.toggleKeymap());
     document.addEventListener('change', releaseFocus);
     document.addEventListener('click', releaseFocus);
     window.addEventListener('keydown', (e) => this.key(e));
@@ -262,6 +267,18 @@ export class Panel {
     if (save) localStorage.setItem(NAVIGATION_KEY, JSON.stringify({ scheme, emulate3: this.ui.emulate3 }));
   }
 
+  // N: the panel out of the way (the view takes its width) and back, as Blender's sidebar.
+  private togglePanel(): void {
+    const panel = $('panel');
+    panel.hidden = !panel.hidden;
+  }
+
+  // ?: the key map over the view.
+  private toggleKeymap(): void {
+    const keymap = $('keymap');
+    keymap.hidden = !keymap.hidden;
+  }
+
   private undo(redo: boolean): void {
     const s = this.s;
     if (!s.editable) return;
@@ -269,8 +286,8 @@ export class Panel {
     s.request({ type: redo ? 'redo' : 'undo' }, redo ? 'redo' : 'undo', 'state');
   }
 
-  // The key map (docs/editor.md): digits pick tools, the numeric keypad's 1, 3, 7 (Ctrl: the
-  // opposite side) look along the axes, as in Blender.
+  // The key map (keymap.ts, docs/editor.md): digits pick tools, the numeric keypad's digits move
+  // the view, as in Blender.
   private key(e: KeyboardEvent): void {
     if (typing(e.target)) return;
     if ($<HTMLDialogElement>('confirm').open) return;
@@ -279,8 +296,11 @@ export class Panel {
     const s = this.s;
     const ctrl = e.ctrlKey || e.metaKey;
     const views: Record<string, [number, number, number]> = { Numpad1: [0, 0, 1], Numpad3: [1, 0, 0], Numpad7: [0, 1, 0] };
+    const turns: Record<string, [number, number]> = { Numpad4: [-kOrbitStep, 0], Numpad6: [kOrbitStep, 0],
+      Numpad8: [0, kOrbitStep], Numpad2: [0, -kOrbitStep], Numpad9: [180, 0] };
     // Disconnected, only the view keys act.
-    const viewKey = views[e.code] !== undefined || e.code === 'NumpadDecimal' || e.key === 'Home' || e.key === 'Escape';
+    const viewKey = views[e.code] !== undefined || turns[e.code] !== undefined || e.code === 'NumpadDecimal' ||
+      e.key === 'Home' || e.key === 'Escape' || e.key === '?' || (key === 'n' && !e.shiftKey);
     if (s.phase.kind === 'disconnected' && !viewKey) {
       if (e.key.length === 1) s.note(`"${e.key}" does nothing while disconnected: the edit waits for the server`);
       return;
@@ -289,6 +309,11 @@ export class Panel {
     if (views[e.code]) {
       e.preventDefault();
       s.viewer.lookFrom(new THREE.Vector3(...views[e.code]).multiplyScalar(ctrl ? -1 : 1));
+    } else if (turns[e.code]) {
+      e.preventDefault();
+      s.viewer.orbitBy(...turns[e.code]);
+    } else if (e.key === '?') {
+      this.toggleKeymap();
     } else if (e.code === 'NumpadDecimal') {
       this.ui.frameSelection();
     } else if (ctrl && key === 'z') {
@@ -311,18 +336,24 @@ export class Panel {
     } else if (e.altKey && key === 'a') {
       e.preventDefault();
       this.ui.selectTopology('none');
+    } else if (e.altKey && key === 'h') {
+      e.preventDefault();
+      this.ui.reveal();
     } else if (e.key === 'Tab' && !ctrl && !e.altKey) {
       e.preventDefault(); // as Blender's Tab: between painting and moving
       this.ui.setTool(this.ui.tool === 'move' ? this.ui.paintTool : 'move');
     } else if (e.key === 'Escape') {
-      this.ui.cancel();
+      if (!$('keymap').hidden) $('keymap').hidden = true;
+      else this.ui.cancel();
     } else if (e.key === 'Home') {
       s.viewer.frame();
     } else if (!ctrl && !e.altKey) {
       const modes: Record<string, Mode> = { g: 'grab', r: 'rotate', s: 'scale' };
       if (tools[e.code]) this.ui.setTool(tools[e.code]);
       else if (modes[key]) this.ui.startModal(modes[key]);
-      else if (key === 'n') $('new-group').click();
+      else if (key === 'n' && e.shiftKey) $('new-group').click();
+      else if (key === 'n') this.togglePanel();
+      else if (key === 'h') this.ui.armHide();
       else if (key === 'l') this.ui.selectTopology('linked');
       else if (key === 'b') this.ui.armBox();
       else if (key === 'a') this.ui.selectTopology('all');
@@ -363,6 +394,7 @@ export class Panel {
         `fixed: ${c.fixed.toLocaleString()} · pinned: ${c.pinned.toLocaleString()}` +
         (s.server?.free_pieces ? ` · ${s.server.free_pieces} piece(s) without handles ${s.ready?.settings.unconstrained === 'keep' ? 'held in place' : 'follow the surface'}` : '') +
         (s.influenceHeld ? ` · ${s.influenceHeld.toLocaleString()} held beyond the region of influence (grey)` : '') +
+        (s.viewer.hiddenCount ? ` · hidden: ${s.viewer.hiddenCount.toLocaleString()} (Alt+H shows them)` : '') +
         ((s.server?.constrained_piece_modes?.length ?? 0) > 1 ? ` · modes per constrained piece: ${s.server!.constrained_piece_modes.join(', ')}` : '')
       : '';
     this.renderNotes();

@@ -8,6 +8,7 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TransformControls } from 'three/addons/controls/TransformControls.js';
 import { MeshBVH } from 'three-mesh-bvh';
 import type { BvhReply, BvhRequest } from './bvh.worker';
+import { visibleTriangles } from './hide';
 import { FileLook } from './look';
 import type { AppearanceMessage } from './protocol';
 
@@ -33,7 +34,9 @@ export class Viewer {
   onDrawTimed: (ms: number, draw: number) => void = () => {}; // a full draw's time; `draw`: its number (draws)
 
   readonly scene = new THREE.Scene();
-  private readonly geometry = new THREE.BufferGeometry();
+  private readonly geometry = new THREE.BufferGeometry(); // every triangle: picking, positions
+  private readonly drawn = new THREE.BufferGeometry(); // the same attributes, the shown triangles
+  private hiddenMask: Uint8Array | null = null; // per vertex: hidden (H), with its triangles
   private readonly surface: THREE.Mesh;
   private readonly wireframe: THREE.Mesh;
   private readonly coarseGeometry = new THREE.BufferGeometry();
@@ -49,6 +52,7 @@ export class Viewer {
   private readonly bvhWorker = new Worker(new URL('./bvh.worker.ts', import.meta.url), { type: 'module' });
   private bvhRequest = 0;
   private coarseVertices = new Uint32Array(0); // mesh vertex of each preview vertex
+  private coarseIndices = new Uint32Array(0); // the preview's triangles, hidden ones included
   private home = { position: new THREE.Vector3(), target: new THREE.Vector3() };
   private renderQueued = false;
 
@@ -64,11 +68,11 @@ export class Viewer {
     this.scene.add(this.camera);
 
     const material = new THREE.MeshLambertMaterial({ vertexColors: true });
-    this.surface = new THREE.Mesh(this.geometry, material);
+    this.surface = new THREE.Mesh(this.drawn, material);
     this.coarse = new THREE.Mesh(this.coarseGeometry, material);
     this.coarse.visible = false;
     this.wireframe = new THREE.Mesh(
-      this.geometry,
+      this.drawn,
       new THREE.MeshBasicMaterial({ color: 0x20242c, wireframe: true, transparent: true, opacity: 0.25 }),
     );
     this.wireframe.visible = false;
@@ -139,6 +143,9 @@ export class Viewer {
     }
     this.geometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
     this.geometry.computeBoundingSphere();
+    for (const name of ['position', 'normal', 'color']) this.drawn.setAttribute(name, this.geometry.getAttribute(name));
+    if (!keepCamera) [this.hiddenMask, this.hiddenCount] = [null, 0];
+    this.showHidden();
     this.bvh = null; // built by the worker (seconds for a million triangles)
     this.bvhStale = false;
     const request: BvhRequest = { id: ++this.bvhRequest, indices: indices.slice(), positions: positions.slice() };
@@ -170,6 +177,7 @@ export class Viewer {
   // The file's look (after its mesh), or none.
   setAppearance(a: AppearanceMessage | null): void {
     this.look.set(a);
+    this.look.setHidden(this.hiddenMask);
     this.look.setPositions(this.positions(), null);
     this.look.setColors(this.geometry.getAttribute('color').array as Float32Array, this.freeColor);
     this.showSurface();
@@ -248,8 +256,9 @@ export class Viewer {
   // The coarse mesh of drags: some mesh vertices and triangles between them.
   setPreview(vertices: Uint32Array, indices: Uint32Array): void {
     this.coarseVertices = vertices.slice();
+    this.coarseIndices = indices.slice();
     const k = vertices.length;
-    this.coarseGeometry.setIndex(new THREE.BufferAttribute(indices.slice(), 1));
+    this.coarseGeometry.setIndex(new THREE.BufferAttribute(visibleTriangles(this.coarseIndices, this.hiddenMask, vertices), 1));
     this.coarseGeometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * k), 3));
     this.coarseGeometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(3 * k), 3));
     this.coarseGeometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * k), 3));
@@ -289,6 +298,46 @@ export class Viewer {
       out[3 * i + 2] = source[3 * v + 2];
     });
     target.needsUpdate = true;
+  }
+
+  // Hides `vertices` and the triangles around them (shown: false reveals them; no list: all),
+  // from drawing and picking alike; returns how many vertices are hidden.
+  setHidden(vertices: ArrayLike<number> | null, shown = false): number {
+    const n = this.geometry.getAttribute('position')?.count ?? 0;
+    if (!vertices) this.hiddenMask = shown ? null : new Uint8Array(n).fill(1);
+    else {
+      this.hiddenMask ??= new Uint8Array(n);
+      for (let i = 0; i < vertices.length; ++i) this.hiddenMask[vertices[i]] = shown ? 0 : 1;
+    }
+    this.hiddenCount = this.hiddenMask?.reduce((a, h) => a + h, 0) ?? 0;
+    if (this.hiddenCount === 0) this.hiddenMask = null;
+    this.showHidden();
+    this.requestRender();
+    return this.hiddenCount;
+  }
+  hiddenCount = 0;
+
+  get drawnTriangles(): number {
+    return (this.drawn.index?.count ?? 0) / 3;
+  }
+
+  get hidden(): Uint8Array | null {
+    return this.hiddenMask;
+  }
+
+  private showHidden(): void {
+    const index = this.geometry.index;
+    if (!index) return;
+    const hidden = this.hiddenMask;
+    this.drawn.setIndex(hidden ? new THREE.BufferAttribute(visibleTriangles(index.array as Uint32Array, hidden), 1) : index);
+    // Behind a hidden part the inside of the surface shows, as in Blender.
+    const material = this.surface.material as THREE.MeshLambertMaterial;
+    const side = hidden ? THREE.DoubleSide : THREE.FrontSide;
+    if (material.side !== side) [material.side, material.needsUpdate] = [side, true];
+    if (this.coarseIndices.length > 0) {
+      this.coarseGeometry.setIndex(new THREE.BufferAttribute(visibleTriangles(this.coarseIndices, hidden, this.coarseVertices), 1));
+    }
+    this.look.setHidden(hidden);
   }
 
   setWireframe(on: boolean): void {
@@ -335,7 +384,11 @@ export class Viewer {
       this.bvhStale = false;
     }
     this.raycaster.setFromCamera(this.ndc(clientX, clientY), this.camera);
-    const hit = this.bvh.raycastFirst(this.raycaster.ray, THREE.DoubleSide);
+    const hidden = this.hiddenMask;
+    const hit = hidden
+      ? this.bvh.raycast(this.raycaster.ray, THREE.DoubleSide).sort((a, b) => a.distance - b.distance)
+        .find((h) => h.face && !hidden[h.face.a] && !hidden[h.face.b] && !hidden[h.face.c])
+      : this.bvh.raycastFirst(this.raycaster.ray, THREE.DoubleSide);
     if (!hit || !hit.face) return null;
     const p = this.positions();
     let best = hit.face.a;
@@ -373,6 +426,7 @@ export class Viewer {
   // Frames the given points (or the whole mesh) without turning the camera; the points' sphere
   // fills about a third of the view, the whole mesh all of it.
   frame(points?: THREE.Vector3[]): void {
+    if (this.geometry.index) this.geometry.computeBoundingSphere(); // as drawn now
     const whole = this.geometry.boundingSphere ?? new THREE.Sphere();
     const sphere = points && points.length > 0 ? new THREE.Sphere().setFromPoints(points) : whole.clone();
     if (points && points.length > 0) sphere.radius = Math.min(whole.radius, Math.max(3 * sphere.radius, 0.15 * whole.radius));
@@ -386,6 +440,18 @@ export class Viewer {
     const d = direction.clone().normalize();
     if (Math.abs(d.y) > 0.999) d.z += 1e-6; // straight down or up: the orbit's up stays Y
     this.camera.position.copy(this.orbit.target).add(d.normalize().multiplyScalar(distance));
+    this.orbit.update();
+    this.requestRender();
+  }
+
+  // Numpad 4, 6, 8, 2: orbits about the target by `degrees` across (right +) or up and down (up +),
+  // as Blender's view orbit steps; numpad 9 (turn: 180 across) looks from the other side.
+  orbitBy(across: number, up: number): void {
+    const offset = this.camera.position.clone().sub(this.orbit.target);
+    const s = new THREE.Spherical().setFromVector3(offset);
+    s.theta -= THREE.MathUtils.degToRad(across);
+    s.phi = THREE.MathUtils.clamp(s.phi - THREE.MathUtils.degToRad(up), 1e-4, Math.PI - 1e-4);
+    this.camera.position.copy(this.orbit.target).add(new THREE.Vector3().setFromSpherical(s));
     this.orbit.update();
     this.requestRender();
   }
