@@ -274,6 +274,10 @@ std::string encode_texture(uint32_t material, std::string_view mime, std::string
   return w.take();
 }
 
+// Below this fraction of the largest coordinate a displacement is rounding (float32 resolves
+// about 6e-8 of it; double solves leave 1e-14).
+constexpr double kRoundingNoise = 1e-9;
+
 std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& stats,
                                 const Vertices& positions, const Vertices& rest,
                                 const PreviewMesh* preview) {
@@ -286,10 +290,14 @@ std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& 
   const auto vertex = [&](size_t i) {
     return subset ? preview->vertices[i] : static_cast<Eigen::Index>(i);
   };
-  double largest = 0.0;
+  double largest = 0.0, extent = 0.0;
   for (size_t i = 0; i < n; ++i) {
     largest = std::max(largest, (positions.row(i) - rest.row(vertex(i))).cwiseAbs().maxCoeff());
+    extent = std::max(extent, rest.row(vertex(i)).cwiseAbs().maxCoeff());
   }
+  // Differences within rounding of the coordinates (a solve at the rest pose) are no motion:
+  // scaled up to the int16 range they would read as one.
+  if (largest <= kRoundingNoise * extent) largest = 0.0;
   const float scale = largest > 0.0 ? static_cast<float>(largest / 32767.0) : 1.0f;
   Writer w;
   w.reserve(52 + 6 * n + 2);

@@ -975,11 +975,16 @@ try {
     log('keys: H, Alt+H');
     await keys('2', 'Home', 'Numpad1');
     const all = await api(() => window.specdeformEditor.drawnTriangles());
+    // Around a point of the model near the middle of the view (a mesh moved by the earlier
+    // tests may leave the middle empty).
+    const on = await api((c) => [[0, 0], [0, -80], [0, 80], [-80, 0], [80, 0], [0, -160], [0, 160]]
+      .map(([dx, dy]) => ({ x: c.x + dx, y: c.y + dy })).find((p) => window.specdeformEditor.onModel(p.x, p.y)), canvas);
+    check(on, 'the model is in the middle of the view');
     const rectangle = async (key) => {
       await keys(key);
-      await page.mouse.move(canvas.x - 60, canvas.y - 40);
+      await page.mouse.move(on.x - 60, on.y - 40);
       await page.mouse.down();
-      await page.mouse.move(canvas.x + 60, canvas.y + 40, { steps: 4 });
+      await page.mouse.move(on.x + 60, on.y + 40, { steps: 4 });
       await page.mouse.up();
     };
     await rectangle('h');

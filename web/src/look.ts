@@ -152,6 +152,12 @@ export class FileLook {
     }
   }
 
+  // Whether the render vertices' normals are these already.
+  hasNormals(normals: Float32Array): boolean {
+    const n = this.geometry.getAttribute('normal')?.array as Float32Array | undefined;
+    return !this.appearance || (n !== undefined && n.length === normals.length && n.every((x, i) => x === normals[i]));
+  }
+
   // The selection's colours (3 per mesh vertex): `free` where the file's own colour shows.
   setColors(colors: Float32Array, free: THREE.Color): void {
     const a = this.appearance;

@@ -38,6 +38,8 @@ const viewer = state.viewer;
   },
   stats,
   draws: () => viewer.draws,
+  fullDraws: () => viewer.fullDraws,
+  drawsSkipped: () => viewer.drawsSkipped,
   restPositions: () => Array.from(state.rest),
   positions: () => Array.from(viewer.positions()),
   labels: () => Array.from(state.labels),

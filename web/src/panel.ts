@@ -37,6 +37,11 @@ function releaseFocus(e: Event): void {
 }
 
 // A loading stage, with its fraction when it has one (a stage without one is reported as 1).
+// Changed text only: each change repaints the window (in software, without a GPU).
+function setText(element: HTMLElement, text: string): void {
+  if (element.textContent !== text) element.textContent = text;
+}
+
 function progressText(phase: { stage: string; fraction: number }): string {
   return phase.fraction < 1 ? `${phase.stage}… ${Math.round(100 * phase.fraction)}%` : `${phase.stage}…`;
 }
@@ -58,6 +63,7 @@ export class Panel {
       this.renderMeasures();
     }, 500);
     setInterval(() => this.renderBanner(), 250);
+    setInterval(() => this.renderStatus(), 1000);
   }
 
   // Asks before replacing an edit that would be lost; resolves true to go on.
@@ -361,6 +367,40 @@ export class Panel {
     }
   }
 
+  // The status over the viewport; a stage that lasts says for how long, so that its line moves
+  // at least once a second (the 1 s timer) even where the server reports no fraction.
+  private renderStatus(): void {
+    const s = this.s;
+    const phase = s.phase;
+    const r = s.ready;
+    const [text, cls] = (() => {
+      switch (phase.kind) {
+        case 'connecting': return [s.connection.open ? 'Connected: receiving the mesh…' : 'Connecting to the server…', 'busy'];
+        case 'disconnected': return ['Disconnected — edits are paused', 'down'];
+        case 'empty': return ['No mesh is open: open one (Open mesh…, or drop a file) or the Demo', 'busy'];
+        case 'loading': return [`${this.aged(phase.stage, progressText(phase))}${s.preparing ? ' · paint handles and fixed parts meanwhile' : ''}`, 'busy'];
+        case 'busy': return [`${phase.what}: waiting for the server…`, 'busy'];
+        case 'ready': return s.server?.detail_pending
+          ? [`${r ? `${r.name}: ` : ''}working: factoring the transfer's details (displacements until then)`, 'busy']
+          : s.saving ? [`${r ? `${r.name}: ` : ''}ready · saving the basis for next time`, 'ready']
+            : [r ? `${r.name}: ready` : 'ready', 'ready'];
+      }
+    })();
+    const working = cls === 'busy' && phase.kind !== 'loading' && phase.kind !== 'empty';
+    setText($('status'), working ? this.aged(text, text) : text);
+    $('status').className = cls;
+    if (phase.kind === 'loading') setText($('progress-stage'), this.aged(phase.stage, progressText(phase)));
+  }
+
+  // `text` with the seconds since `stage` began (from 1 s on).
+  private aged(stage: string, text: string): string {
+    const now = performance.now();
+    if (stage !== this.stage.name) this.stage = { name: stage, since: now };
+    const seconds = Math.floor((now - this.stage.since) / 1000);
+    return seconds >= 1 ? `${text} · ${seconds} s` : text;
+  }
+  private stage = { name: '', since: 0 };
+
   // ------------------------------------------------------------ rendering
 
   private render(): void {
@@ -370,23 +410,7 @@ export class Panel {
     const editable = s.editable;
     const r = s.ready;
 
-    // Status, over the viewport.
-    const status = $('status');
-    const [text, cls] = (() => {
-      switch (phase.kind) {
-        case 'connecting': return ['Connecting to the server…', 'busy'];
-        case 'disconnected': return ['Disconnected — edits are paused', 'down'];
-        case 'empty': return ['No mesh is open: open one (Open mesh…, or drop a file) or the Demo', 'busy'];
-        case 'loading': return [`${progressText(phase)}${s.preparing ? ' · paint handles and fixed parts meanwhile' : ''}`, 'busy'];
-        case 'busy': return [`${phase.what}: waiting for the server…`, 'busy'];
-        case 'ready': return s.server?.detail_pending
-          ? [`${r ? `${r.name}: ` : ''}working: factoring the transfer's details (displacements until then)`, 'busy']
-          : s.saving ? [`${r ? `${r.name}: ` : ''}ready · saving the basis for next time`, 'ready']
-            : [r ? `${r.name}: ready` : 'ready', 'ready'];
-      }
-    })();
-    status.textContent = text;
-    status.className = cls;
+    this.renderStatus();
     const c = s.counts();
     $('hint').textContent = s.paintable ? this.nextStep(c) : '';
     $('counts').textContent = r && editable
@@ -404,7 +428,6 @@ export class Panel {
     $('progress').hidden = !loading;
     $('progress').classList.toggle('aside', s.preparing); // the mesh it prepares is painted meanwhile
     if (loading) {
-      $('progress-stage').textContent = progressText(phase);
       $<HTMLProgressElement>('progress-bar').value = phase.fraction;
       $<HTMLButtonElement>('cancel').hidden = !phase.cancellable;
     } else {

@@ -543,10 +543,10 @@ export class EditorState {
   private drawTimed(ms: number, draw: number): void {
     if (this.previewFrom === null) return;
     // An earlier draw's time: the viewer times one draw at a time, so the mesh's first was not.
-    if (draw < this.previewFrom) return this.viewer.requestRender();
+    if (draw < this.previewFrom) return this.viewer.requestRender(true);
     if (draw === this.previewFrom && ms > kFullDrawBudgetMs && ms < kUploadMs) {
       this.previewFrom = draw + 1;
-      return this.viewer.requestRender();
+      return this.viewer.requestRender(true);
     }
     this.previewFrom = null;
     this.drawMs = ms;

@@ -163,7 +163,7 @@ export class Viewer {
       this.home = { position: this.camera.position.clone(), target: this.orbit.target.clone() };
       this.gizmo.setSize(0.8);
     }
-    this.requestRender();
+    this.changedContent();
   }
 
   positions(): Float32Array {
@@ -181,19 +181,19 @@ export class Viewer {
     this.look.setPositions(this.positions(), null);
     this.look.setColors(this.geometry.getAttribute('color').array as Float32Array, this.freeColor);
     this.showSurface();
-    this.requestRender();
+    this.changedContent();
   }
 
   async setTexture(material: number, mime: string, image: Uint8Array): Promise<void> {
     await this.look.setTexture(material, mime, image);
-    this.requestRender();
+    this.changedContent();
   }
 
   // Whether the file's look is drawn (where it has one) or the plain surface.
   showLook(on: boolean): void {
     this.lookShown = on;
     this.showSurface();
-    this.requestRender();
+    this.changedContent();
   }
 
   get drawingLook(): boolean {
@@ -212,9 +212,14 @@ export class Viewer {
   // look's normals when it has one.
   setPositions(positions: Float32Array, normals: Float32Array, lookNormals: Float32Array | null = null): void {
     const p = this.geometry.getAttribute('position') as THREE.BufferAttribute;
+    const nrm = this.geometry.getAttribute('normal') as THREE.BufferAttribute;
+    // The same again (a frame at the rest shape while it is shown): nothing to upload or draw.
+    const same = this.shaded && !this.coarse.visible && equal(p.array as Float32Array, positions) &&
+      equal(nrm.array as Float32Array, normals) && (lookNormals === null || this.look.hasNormals(lookNormals));
+    this.previewLabel.hidden = true;
+    if (same) return this.requestRender(); // answered by onRendered, without a draw
     (p.array as Float32Array).set(positions);
     p.needsUpdate = true;
-    const nrm = this.geometry.getAttribute('normal') as THREE.BufferAttribute;
     (nrm.array as Float32Array).set(normals);
     nrm.needsUpdate = true;
     this.bvhStale = true;
@@ -222,8 +227,7 @@ export class Viewer {
     this.shaded = true;
     this.look.setPositions(positions, lookNormals);
     this.showSurface();
-    this.previewLabel.hidden = true;
-    this.requestRender();
+    this.changedContent();
   }
 
   // Colours (3 floats per vertex) of the vertices listed, or of all.
@@ -250,7 +254,7 @@ export class Viewer {
     attribute.needsUpdate = true;
     this.syncCoarseColors();
     this.look.setColors(array, this.freeColor);
-    this.requestRender();
+    this.changedContent();
   }
 
   // The coarse mesh of drags: some mesh vertices and triangles between them.
@@ -280,7 +284,7 @@ export class Viewer {
     this.surface.visible = false;
     this.look.mesh.visible = false;
     this.previewLabel.hidden = false;
-    this.requestRender();
+    this.changedContent();
   }
 
   get showingPreview(): boolean {
@@ -312,7 +316,7 @@ export class Viewer {
     this.hiddenCount = this.hiddenMask?.reduce((a, h) => a + h, 0) ?? 0;
     if (this.hiddenCount === 0) this.hiddenMask = null;
     this.showHidden();
-    this.requestRender();
+    this.changedContent();
     return this.hiddenCount;
   }
   hiddenCount = 0;
@@ -342,7 +346,7 @@ export class Viewer {
 
   setWireframe(on: boolean): void {
     this.wireframe.visible = on;
-    this.requestRender();
+    this.changedContent();
   }
 
   // The brush's circle, on the surface's tangent plane at `hit`; null hides it. Drawn over the
@@ -373,7 +377,7 @@ export class Viewer {
   showCursor(point: THREE.Vector3 | null): void {
     this.cursorMark.visible = point !== null;
     if (point) this.cursorMark.position.copy(point);
-    this.requestRender();
+    this.changedContent();
   }
 
   pick(clientX: number, clientY: number): Hit | null {
@@ -490,19 +494,48 @@ export class Viewer {
     });
   }
 
-  // Draws on the next animation frame. A slow draw (the full large mesh without a GPU) is
-  // followed by as long without one, so that pointer events, which wait for the frame being drawn, still
-  // come in at once half of the time.
-  requestRender(): void {
+  // What a draw would show: the canvas' size, the camera, the gizmo, the 3D cursor and the
+  // version of the drawn content (changedContent); a requested draw that would show the same is
+  // not made (a full draw of a million triangles takes most of a second without a GPU).
+  private showing(): string {
+    const c = this.camera, g = this.gizmo as TransformControls & { dragging: boolean };
+    const gizmo = g.object ? [g.mode, g.axis, g.dragging, g.size, g.space, ...this.pivot.position.toArray(),
+      ...this.pivot.quaternion.toArray(), ...this.pivot.scale.toArray()] : [];
+    const cursor = this.cursorMark.visible ? this.cursorMark.position.toArray() : [];
+    return [this.canvas.width, this.canvas.height, ...c.position.toArray(), ...c.quaternion.toArray(),
+      ...c.projectionMatrix.elements, this.contentVersion, gizmo.join(), cursor.join()].join();
+  }
+  private shown = '';
+  private contentVersion = 0;
+
+  private changedContent(): void {
+    ++this.contentVersion;
+    this.requestRender();
+  }
+
+  // Draws on the next animation frame (`again`: even if it would show the same, to time a
+  // draw). A slow draw (the full large mesh without a GPU) is followed by as long without one,
+  // so that pointer events, which wait for the frame being drawn, still come in at once half of
+  // the time.
+  requestRender(again = false): void {
+    this.drawAgain ||= again;
     if (this.renderQueued) return;
     this.renderQueued = true;
     const draw = () => requestAnimationFrame(() => {
       this.renderQueued = false;
+      const showing = this.showing();
+      if (showing === this.shown && !this.drawAgain) {
+        ++this.drawsSkipped;
+        return this.onRendered(); // what was asked for is on the screen already
+      }
+      [this.shown, this.drawAgain] = [showing, false];
       this.renderer.render(this.scene, this.camera);
       this.lastDraw = performance.now();
       ++this.draws;
-      // The full mesh's draws, timed one at a time, pace the next.
-      if (!this.coarse.visible && !this.timingDraw) {
+      // The full mesh's draws, timed one at a time, pace the next (a draw without it is quick).
+      const full = this.surface.visible || this.look.mesh.visible;
+      if (full) ++this.fullDraws;
+      if (full && !this.timingDraw) {
         this.timingDraw = true;
         const draw = this.draws;
         void this.timeSubmitted().then((ms) => {
@@ -514,7 +547,8 @@ export class Viewer {
       this.drawBrush();
       this.onRendered();
     });
-    const slow = this.drawMs > kSlowDrawMs && !this.coarse.visible; // the preview draws fast
+    // The preview draws fast; a request that would show the same is answered at once.
+    const slow = this.drawMs > kSlowDrawMs && !this.coarse.visible && this.showing() !== this.shown;
     const wait = slow ? this.lastDraw + this.drawMs - performance.now() : 0;
     if (wait > 0) setTimeout(draw, wait);
     else draw();
@@ -522,6 +556,9 @@ export class Viewer {
   drawMs = 0; // the full mesh's last timed draw
   private timingDraw = false;
   draws = 0; // made so far, of whatever is shown
+  fullDraws = 0; // of them, of the full mesh
+  drawsSkipped = 0; // asked for, but they would have shown what was shown
+  private drawAgain = false;
   private lastDraw = -Infinity;
 
   // The axis widget: the world axes as the camera sees them, +X red, +Y green, +Z blue.
@@ -584,6 +621,12 @@ export class Viewer {
     this.camera.updateProjectionMatrix();
     this.requestRender();
   }
+}
+
+function equal(a: Float32Array, b: Float32Array): boolean {
+  if (a.length !== b.length) return false;
+  for (let i = 0; i < a.length; ++i) if (a[i] !== b[i]) return false;
+  return true;
 }
 
 // Draws slower than this are spaced out (requestRender).
