@@ -209,17 +209,26 @@ class Request:
 
 
 def _check(obj):
-    """Why the settings cannot be bound, or None."""
+    """Why the settings cannot be bound, or None: each line names the panel's field to fix."""
     s, groups = obj.specdeform, obj.vertex_groups
     for i, (group, target, _) in enumerate(handles(obj)):
-        if not group or group not in groups:
-            return f"no vertex group '{group}' for handle {i + 1}"
+        field = "Handle" if i == 0 else f"More handles, row {i}"
+        if not group:
+            if len(groups) == 0:
+                return (f"{field}: the mesh has no vertex groups; add one with the vertices to "
+                        "move (Object Data properties, Vertex Groups) and pick it")
+            return f"{field}: pick the vertex group to move"
+        if group not in groups:
+            return f"{field}: this mesh has no vertex group '{group}'"
         if target is None or target == obj:
-            return f"handle {i + 1}: choose a target object (normally an Empty) other than the mesh"
+            what = "Target" if i == 0 else f"More handles, row {i}, target"
+            return (f"{what}: choose the object that moves the handle (normally an Empty), "
+                    "not the mesh")
     if s.fixed_group and s.fixed_group not in groups:
-        return f"no vertex group '{s.fixed_group}' for the fixed region"
+        return f"Fixed: this mesh has no vertex group '{s.fixed_group}' (or leave Fixed empty)"
     if obj.data.shape_keys is not None:
-        return "the mesh has shape keys: apply or remove them first"
+        return ("Shape Keys (Object Data properties): the mesh has shape keys; apply or remove "
+                "them first")
     return None
 
 
@@ -229,15 +238,24 @@ def _levels(h, indices, weights):
     return [(indices[rounded == w], (h, float(w))) for w in np.unique(rounded)]
 
 
-def _shared(names, members):
-    """Two of the groups (handles, fixed) that share vertices, said in one line, or None."""
+def _shared(names, fields, members):
+    """Two of the groups (handles, fixed) that share vertices, said in one line naming the
+    field to change, or None."""
     for i, a in enumerate(names):
-        for b in names[i + 1:]:
+        for j in range(i + 1, len(names)):
+            b = names[j]
             if a == b:
-                return f"vertex group '{a}' is used twice: each vertex follows one handle"
+                return (f"{fields[j]}: vertex group '{a}' is used twice (also {fields[i]}): "
+                        "each vertex follows one handle")
             if np.intersect1d(members[a][0], members[b][0]).size:
-                return f"vertex groups '{a}' and '{b}' share vertices: each follows one handle"
+                return (f"{fields[j]}: vertex groups '{a}' and '{b}' share vertices: "
+                        "each follows one handle")
     return None
+
+
+def _fields(obj):
+    """The panel's name of each handle's field, then the fixed group's."""
+    return ["Handle"] + [f"More handles, row {i}" for i in range(1, len(handles(obj)))] + ["Fixed"]
 
 
 def request(obj):
@@ -268,14 +286,15 @@ def select(obj, r):
     the worker computes the basis); an error message, or None."""
     s = obj.specdeform
     names = [group for group, _, _ in handles(obj)] + [s.fixed_group] * bool(s.fixed_group)
+    fields = _fields(obj)[:len(names)]
     weights = mesh_helpers.group_weights(obj, set(names))
     members = {}
     for name, (indices, w) in weights.items():
         keep = r.renumber[indices] >= 0
         if not keep.any():
-            return f"vertex group '{name}' holds no vertex of a face"
+            return f"{fields[names.index(name)]}: vertex group '{name}' holds no vertex of a face"
         members[name] = (r.renumber[indices][keep], w[keep])
-    problem = _shared(names, members)
+    problem = _shared(names, fields, members)
     if problem:
         return problem
     split = [x for h, (group, _, _) in enumerate(handles(obj)) for x in _levels(h, *members[group])]
@@ -373,12 +392,17 @@ class BasisJob:
 
 
 def _basis_line(evals, h):
-    """The panel's line on the basis, saying why it holds more modes than asked."""
-    line = f"{len(evals)} modes" + ("" if h.converged else ", approximate")
+    """The panel's line on the basis, in words: how good it is for deforming, and why it holds
+    more modes than asked."""
     if h.approximate:
-        line += " (multilevel)"
+        line = f"Approximate basis (multilevel), {len(evals)} modes: fine for deformation"
+    elif h.converged:
+        line = f"Exact basis, {len(evals)} modes (residual {h.max_residual:.0e})"
+    else:
+        line = (f"Basis of {len(evals)} modes, not fully converged (residual "
+                f"{h.max_residual:.0e}): fine for deformation")
     if len(evals) > h.requested_modes > 0:
-        line += f": {h.requested_modes} asked, more as each of {h.pieces} loose parts gets its own"
+        line += f"; {h.requested_modes} asked, more as each of {h.pieces} loose parts gets its own"
     return line
 
 
@@ -410,7 +434,6 @@ def bind(obj, r, job):
         "basis_s": job.seconds,
         "bind_s": job.seconds + time.perf_counter() - start,
         "basis": _basis_line(evals, h),
-        "residual": h.max_residual,
     }
     # All vertices in faces: a slice, which numpy writes ten times faster than an index array.
     used = slice(None) if len(r.used) == len(r.rest) else r.used

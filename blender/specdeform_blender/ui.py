@@ -1,9 +1,26 @@
 """The sidebar (N) panel: handles, fixed group, settings, Bind / Unbind / Apply, Bake, timings and
 status."""
 
+import textwrap
+
 import bpy
 
 from . import binding, library
+
+# Average width of a character of the panel's text, in pixels at UI scale 1 (Blender's default
+# font at its default size), and the panel's margins.
+CHAR_PX = 6.5
+MARGIN_PX = 40
+
+
+def _say(context, layout, text, icon="NONE"):
+    """`text` wrapped at the sidebar's width (the first line with the icon): no line is cut off
+    with "..." however narrow the sidebar."""
+    width = context.region.width if context.region else 300
+    chars = max(16, int((width - MARGIN_PX) / (CHAR_PX * context.preferences.view.ui_scale)))
+    column = layout.column(align=True)
+    for i, line in enumerate(textwrap.wrap(text, chars) or [""]):
+        column.label(text=line, icon=icon if i == 0 else "BLANK1" if icon != "NONE" else "NONE")
 
 
 class SPECDEFORM_UL_handles(bpy.types.UIList):
@@ -15,30 +32,26 @@ class SPECDEFORM_UL_handles(bpy.types.UIList):
         row.prop(item, "target", text="")
 
 
-def _status(layout, obj, s):
+def _status(context, layout, obj, s):
     b = binding.binding(obj)
     if obj.name_full in binding.problems:
-        layout.label(text=binding.problems[obj.name_full], icon="ERROR")
+        _say(context, layout, binding.problems[obj.name_full], "ERROR")
     elif s.bound and b is None:
-        layout.label(text="Bound in the file: press Bind to resume", icon="INFO")
+        _say(context, layout, "Bound in the file: press Bind to resume", "INFO")
     if b is None:
         return
     if obj.mode == "EDIT":
-        layout.label(text="Edit Mode edits the rest shape;", icon="INFO")
-        layout.label(text="leaving it binds again and poses it")
+        _say(context, layout, "Edit Mode edits the rest shape; leaving it binds again and "
+             "poses it", "INFO")
     st = b.status
-    layout.label(text=f"Basis: {st['basis']}")
-    layout.label(text=f"Residual {st['residual']:.0e}")
-    layout.label(text=f"Bind {st['bind_s']:.2f} s (basis {st['basis_s']:.2f} s)")
+    _say(context, layout, st["basis"])
+    _say(context, layout, f"Bind {st['bind_s']:.2f} s (basis {st['basis_s']:.2f} s)")
     if "solve_ms" in st:
-        layout.label(text=f"Solve {st['solve_ms']:.1f} ms, {st['iterations']} iterations")
-        layout.label(text=f"Write {st['write_ms']:.1f} ms")
-    if "detail" in st:
-        layout.label(text=st["detail"], icon="TIME")
-    if "note" in st:
-        layout.label(text=st["note"], icon="INFO")
-    if "error" in st:
-        layout.label(text=st["error"], icon="ERROR")
+        _say(context, layout, f"Solve {st['solve_ms']:.1f} ms, {st['iterations']} iterations; "
+             f"write {st['write_ms']:.1f} ms")
+    for key, icon in (("detail", "TIME"), ("note", "INFO"), ("error", "ERROR")):
+        if key in st:
+            _say(context, layout, st[key], icon)
 
 
 class VIEW3D_PT_specdeform(bpy.types.Panel):
@@ -54,7 +67,7 @@ class VIEW3D_PT_specdeform(bpy.types.Panel):
     def draw(self, context):
         layout = self.layout
         if library.specdeform is None:
-            layout.label(text=library.problem, icon="ERROR")
+            _say(context, layout, library.problem, "ERROR")
             return
         obj = context.object
         s = obj.specdeform
@@ -82,4 +95,4 @@ class VIEW3D_PT_specdeform(bpy.types.Panel):
         row = layout.row(align=True)
         row.operator("specdeform.bake")
         row.operator("specdeform.bake_pose")
-        _status(layout, obj, s)
+        _status(context, layout, obj, s)

@@ -112,11 +112,13 @@ class Layout:
     prop_search = operator = template_list = prop
 
 
-def panel_lines(obj):
-    """The lines of text the sidebar panel shows for `obj`."""
+def panel_lines(obj, width=100000):
+    """The lines of text the sidebar panel shows for `obj` in a sidebar `width` pixels wide."""
     from specdeform_blender import ui
 
     panel = type("Panel", (), {"layout": Layout()})()
-    context = type("Context", (), {"object": obj})()
+    region = type("Region", (), {"width": width})()
+    context = type("Context", (), {"object": obj, "region": region,
+                                   "preferences": bpy.context.preferences})()
     ui.VIEW3D_PT_specdeform.draw(panel, context)
     return panel.layout.labels
