@@ -40,6 +40,7 @@ class Binding:
 
 _bindings = {}  # Object.name_full -> Binding (a renamed object is bound again from the file)
 problems = {}  # Object.name_full -> why a bound object has no binding (one line)
+notices = {}  # Object.name_full -> what the add-on did on its own (unbound, one line)
 _jobs = set()  # BasisJobs whose thread still runs (computing, or saving the cache)
 
 
@@ -51,6 +52,7 @@ def binding(obj):
 def forget_all():
     _bindings.clear()
     problems.clear()
+    notices.clear()
 
 
 def shutdown():
@@ -226,6 +228,9 @@ def _check(obj):
                     "not the mesh")
     if s.fixed_group and s.fixed_group not in groups:
         return f"Fixed: this mesh has no vertex group '{s.fixed_group}' (or leave Fixed empty)"
+    if obj.data.users > 1:
+        return (f"Object Data: the mesh '{obj.data.name}' is shared by {obj.data.users} objects "
+                "(a linked duplicate); Object > Relation > Make Single User, then Bind")
     if obj.data.shape_keys is not None:
         return ("Shape Keys (Object Data properties): the mesh has shape keys; apply or remove "
                 "them first")
@@ -446,6 +451,7 @@ def bind(obj, r, job):
         s.bound = True
         b.last = local_transforms(obj)
     _bindings[obj.name_full] = b
+    notices.pop(obj.name_full, None)
     problems.pop(obj.name_full, None)
     update(obj, b)
     return None

@@ -30,13 +30,27 @@ def _rebind_edited(obj):
         binding.binding(obj).status["note"] = "Bound again from the edited rest shape"
 
 
+def _changed_outside(obj, before):
+    """The mesh's vertices changed in number outside Edit Mode (a modifier applied, Join,
+    Separate, Decimate): the binding no longer fits it and its shown shape is the pose already,
+    so it is unbound and kept as shown (binding again from it would pose it twice)."""
+    binding.release(obj)
+    binding.notices[obj.name_full] = (
+        f"Unbound: the mesh went from {before:,} to {len(obj.data.vertices):,} vertices outside "
+        "Edit Mode (a modifier applied, Join or Separate); it keeps the shape shown. Bind to "
+        "deform it again")
+
+
 def _follow(obj, b, depsgraph):
     if obj.mode == "EDIT":
         if not b.editing:
             _show_rest(obj, b)
         return
-    if b.editing or len(b.rest) != len(obj.data.vertices):
+    if b.editing:
         _rebind_edited(obj)
+        return
+    if len(b.rest) != len(obj.data.vertices):
+        _changed_outside(obj, len(b.rest))
         return
     if all(target for _, target, _ in binding.handles(obj)):
         try:

@@ -38,6 +38,8 @@ def _status(context, layout, obj, s):
         _say(context, layout, binding.problems[obj.name_full], "ERROR")
     elif s.bound and b is None:
         _say(context, layout, "Bound in the file: press Bind to resume", "INFO")
+    elif obj.name_full in binding.notices and not s.bound:
+        _say(context, layout, binding.notices[obj.name_full], "INFO")
     if b is None:
         return
     if obj.mode == "EDIT":

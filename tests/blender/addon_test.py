@@ -197,6 +197,34 @@ def check_polygons():
     assert np.array_equal(support.evaluated(obj), co)
 
 
+def check_modifier_apply():
+    """Applying a Subdivision Surface while posed: the subdivided pose stays (unbound, said in one
+    line), never the pose applied twice; moving the target back changes nothing."""
+    V, F = specdeform.bumpy_bar(cells_per_unit=6)
+    handle, fixed = np.flatnonzero(V[:, 0] > 3.6), np.flatnonzero(V[:, 0] < 0.4)
+    obj, empty = support.add_object("applied", V, F, handle, fixed)
+    support.bind(obj)
+    T = np.eye(4)
+    T[:3, 3] = (0, 0.4, 0)
+    support.move(empty, T)
+    bpy.context.view_layer.objects.active = obj
+    obj.modifiers.new("subdivision", "SUBSURF").levels = 1
+    shown = support.evaluated(obj)
+    assert bpy.ops.object.modifier_apply(modifier="subdivision") == {"FINISHED"}
+    bpy.context.view_layer.update()
+    assert not obj.specdeform.bound and len(obj.data.vertices) == len(shown)
+    line = support.panel_lines(obj)[0]
+    assert line.startswith("Unbound: the mesh went from") and "modifier applied" in line, line
+    assert np.abs(support.evaluated(obj) - shown).max() <= 1e-6 * support.diagonal(shown)
+    support.move(empty, np.eye(4))
+    assert np.abs(support.evaluated(obj) - shown).max() <= 1e-6 * support.diagonal(shown)
+    # A linked duplicate would write the same mesh as its original: refused, naming the fix.
+    twin = obj.copy()
+    bpy.context.collection.objects.link(twin)
+    expect_refusal(obj, "Object Data: the mesh")
+    bpy.data.objects.remove(twin)
+
+
 def check_loose_parts():
     """A loose ring around the bar follows it (rigidly) by default and stays with Keep."""
     Vb, Fb = specdeform.bumpy_bar(cells_per_unit=8)
@@ -244,6 +272,7 @@ def main():
         if SCENE == "generated":
             check_polygons()
             check_loose_parts()
+            check_modifier_apply()
     print("passed")
 
 
