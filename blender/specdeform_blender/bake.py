@@ -19,7 +19,7 @@ def _poses(obj, scene, frames):
     with binding.final_frames():
         for frame in frames:
             scene.frame_set(frame)
-            poses.append(mesh_helpers.coordinates(obj.data))
+            poses.append(mesh_helpers.shown(obj.data))
     scene.frame_set(current)
     return np.array(poses)
 
@@ -27,7 +27,7 @@ def _poses(obj, scene, frames):
 def _unbind(obj):
     rest = mesh_helpers.saved_rest(obj.data)
     binding.release(obj)
-    mesh_helpers.set_coordinates(obj.data, rest)
+    mesh_helpers.restore(obj, rest)
 
 
 def _shape_key(obj, name, co):
@@ -139,7 +139,7 @@ class SPECDEFORM_OT_bake_pose(bpy.types.Operator):
     def execute(self, context):
         obj = context.object
         binding.finish(obj)
-        pose = mesh_helpers.coordinates(obj.data)
+        pose = mesh_helpers.shown(obj.data)
         _unbind(obj)
         _shape_key(obj, "specdeform pose", pose).value = 1.0
         return {"FINISHED"}

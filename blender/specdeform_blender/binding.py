@@ -28,8 +28,9 @@ class Binding:
     rest: np.ndarray  # float32 (n, 3): the input, every vertex
     used: object  # the vertices the faces use, in the deformer's numbering (or all: a slice)
     levels: list  # (handle, weight) of each of the deformer's handle groups
-    positions: np.ndarray = None  # float32 (n, 3): what is written into the mesh
+    positions: np.ndarray = None  # float32 (n, 3): the pose (written as Strength mixes it)
     last: np.ndarray = None  # the transforms last solved for
+    mix: tuple = (True, 1.0)  # Enabled and Strength last written
     editing: bool = False  # in Edit Mode: the mesh shows its rest shape
     exact: bool = True  # the mesh shows the full details (not displacements meanwhile)
     full_ms: float = 0.0  # the last update with the full details took this long
@@ -153,7 +154,17 @@ def update(obj, b, depsgraph=None, full=False):
     in full."""
     transforms = local_transforms(obj, depsgraph)
     final = full or _must_be_final()
+    s = obj.specdeform
+    mix = (s.enabled, s.strength)
+    if not s.enabled:  # the rest shown; solved again once enabled if the targets moved
+        if b.mix != mix:
+            b.mix = mix
+            mesh_helpers.show(obj.data, b.rest)
+        return
     if b.last is not None and np.array_equal(transforms, b.last) and (b.exact or not final):
+        if b.mix != mix:
+            b.mix = mix
+            _write(obj, b)
         return
     start = time.perf_counter()
     T = blend(transforms, b.levels)
@@ -171,8 +182,8 @@ def update(obj, b, depsgraph=None, full=False):
     if not quick and not pending:
         b.full_ms = 1e3 * (solved - start)
     b.exact = not quick and not pending
-    b.last = transforms  # before writing: the write triggers the depsgraph handler again
-    mesh_helpers.set_coordinates(obj.data, b.positions)
+    b.last, b.mix = transforms, mix  # before writing: the write triggers the handler again
+    _write(obj, b)
     st = b.status
     st.pop("error", None)
     if quick:
@@ -191,6 +202,16 @@ def update(obj, b, depsgraph=None, full=False):
     st["solve_ms"] = 1e3 * (solved - start)
     st["quick"] = quick
     st["write_ms"] = 1e3 * (time.perf_counter() - solved)
+
+
+def _write(obj, b):
+    """The mesh's coordinates: the pose, or rest + strength x (pose - rest)."""
+    strength = b.mix[1]
+    if strength == 1.0:
+        mesh_helpers.show(obj.data, b.positions)
+    else:
+        shown = b.rest + np.float32(strength) * (b.positions - b.rest)
+        mesh_helpers.show(obj.data, shown)
 
 
 @dataclass
@@ -231,9 +252,6 @@ def _check(obj):
     if obj.data.users > 1:
         return (f"Object Data: the mesh '{obj.data.name}' is shared by {obj.data.users} objects "
                 "(a linked duplicate); Object > Relation > Make Single User, then Bind")
-    if obj.data.shape_keys is not None:
-        return ("Shape Keys (Object Data properties): the mesh has shape keys; apply or remove "
-                "them first")
     return None
 
 
@@ -272,7 +290,7 @@ def request(obj):
     mesh = obj.data
     rest = mesh_helpers.saved_rest(mesh) if s.bound else None
     if rest is None:
-        rest = mesh_helpers.coordinates(mesh)
+        rest = mesh_helpers.rest_coordinates(mesh)
     F = mesh_helpers.triangles(mesh)
     if len(F) == 0:
         return "the mesh has no faces"
@@ -445,6 +463,7 @@ def bind(obj, r, job):
     b = Binding(d, r.rest, used, r.levels, positions=r.rest.copy(), status=status)
     if not s.bound:  # the input stays as it is until a target moves
         mesh_helpers.save_rest(obj.data, r.rest)
+        mesh_helpers.add_pose_key(obj)
         for _, target, owner in handles(obj):
             in_target = target.matrix_world.inverted() @ obj.matrix_world
             owner.bound_matrix = [x for row in in_target for x in row]

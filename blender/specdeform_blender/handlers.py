@@ -21,7 +21,7 @@ def _show_rest(obj, b):
 def _rebind_edited(obj):
     """Leaving Edit Mode: the mesh as edited is the new rest; bound again from it (the basis from
     the cache when the mesh did not change) and posed again."""
-    mesh_helpers.save_rest(obj.data, mesh_helpers.coordinates(obj.data))
+    mesh_helpers.save_rest(obj.data, mesh_helpers.rest_coordinates(obj.data))
     binding._bindings.pop(obj.name_full, None)
     error = binding.bind_now(obj)
     if error:

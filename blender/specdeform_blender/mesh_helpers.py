@@ -16,6 +16,69 @@ def set_coordinates(mesh, co):
     mesh.update()
 
 
+# On a mesh with shape keys the pose lives in a key of its own, relative to the basis, which
+# holds the rest: the other keys still add their offsets on top of the pose.
+POSE_KEY = "specdeform"
+
+
+def pose_key(mesh):
+    """The add-on's shape key, where the mesh has shape keys and it was made (Bind), or None."""
+    keys = mesh.shape_keys
+    return keys.key_blocks.get(POSE_KEY) if keys is not None else None
+
+
+def add_pose_key(obj):
+    """Bind on a mesh with shape keys: the add-on's key, a copy of the basis at value 1; the
+    basis stays the active key (Edit Mode edits the rest)."""
+    mesh = obj.data
+    if mesh.shape_keys is None or pose_key(mesh) is not None:
+        return
+    active = obj.active_shape_key_index
+    key = obj.shape_key_add(name=POSE_KEY, from_mix=False)
+    key.relative_key = mesh.shape_keys.reference_key
+    key.value = 1.0
+    obj.active_shape_key_index = active
+
+
+def rest_coordinates(mesh):
+    """The shape the deformation starts from: the basis key's, or the mesh's own coordinates."""
+    keys = mesh.shape_keys
+    if keys is None:
+        return coordinates(mesh)
+    co = np.empty(3 * len(mesh.vertices), np.float32)
+    keys.reference_key.data.foreach_get("co", co)
+    return co.reshape(-1, 3)
+
+
+def shown(mesh):
+    """The pose as the add-on wrote it: its key's coordinates, or the mesh's own."""
+    key = pose_key(mesh)
+    if key is None:
+        return coordinates(mesh)
+    co = np.empty(3 * len(mesh.vertices), np.float32)
+    key.data.foreach_get("co", co)
+    return co.reshape(-1, 3)
+
+
+def show(mesh, co):
+    """Writes the pose: into the add-on's key, or the mesh's own coordinates."""
+    key = pose_key(mesh)
+    if key is None:
+        return set_coordinates(mesh, co)
+    key.data.foreach_set("co", np.ascontiguousarray(co, np.float32).ravel())
+    mesh.update()
+
+
+def restore(obj, rest):
+    """Unbind: the add-on's key removed (the basis is the rest), or the rest written back."""
+    key = pose_key(obj.data)
+    if key is not None:
+        obj.shape_key_remove(key)
+        obj.data.update()
+    else:
+        set_coordinates(obj.data, rest)
+
+
 def triangles(mesh):
     """The mesh's faces triangulated (Blender's loop triangles): vertex indices (f, 3)."""
     mesh.calc_loop_triangles()

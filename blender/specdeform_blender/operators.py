@@ -79,7 +79,7 @@ class SPECDEFORM_OT_unbind(bpy.types.Operator):
             self.report({"ERROR"}, "the input coordinates are gone (the mesh was edited)")
             return {"CANCELLED"}
         binding.release(obj)
-        mesh_helpers.set_coordinates(obj.data, rest)
+        mesh_helpers.restore(obj, rest)
         return {"FINISHED"}
 
 
@@ -95,8 +95,12 @@ class SPECDEFORM_OT_apply(bpy.types.Operator):
         return _poll_mesh(context) and context.object.specdeform.bound
 
     def execute(self, context):
-        binding.finish(context.object)
-        binding.release(context.object)
+        obj = context.object
+        binding.finish(obj)
+        binding.release(obj)
+        key = mesh_helpers.pose_key(obj.data)
+        if key is not None:  # with shape keys the pose stays a key of its own, at value 1
+            key.name = "specdeform pose"
         return {"FINISHED"}
 
 

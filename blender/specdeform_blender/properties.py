@@ -21,6 +21,11 @@ def _bound_matrix():
     )
 
 
+def _retag(self, _context):
+    """Enabled or Strength changed: the depsgraph handler writes the mesh again."""
+    self.id_data.update_tag()
+
+
 class SpecdeformHandle(bpy.types.PropertyGroup):
     """A further handle: a vertex group and the object that moves it."""
 
@@ -106,5 +111,21 @@ class SpecdeformSettings(bpy.types.PropertyGroup):
         "added as displacements, and the full details follow once it rests for a quarter second "
         "(renders and bakes always have them)",
         default=True,
+    )
+    enabled: BoolProperty(
+        name="Enabled",
+        description="Show the pose (off: the rest shape), in the viewport and in renders, as a "
+        "modifier's toggles",
+        default=True,
+        update=_retag,
+    )
+    strength: FloatProperty(
+        name="Strength",
+        description="How much of the pose is shown: rest + strength x (pose - rest); keyframable",
+        default=1.0,
+        min=0.0,
+        max=1.0,
+        subtype="FACTOR",
+        update=_retag,
     )
     bound: BoolProperty(name="Bound", description="The mesh follows the target", default=False)

@@ -90,6 +90,8 @@ class VIEW3D_PT_specdeform(bpy.types.Panel):
         col.prop(s, "unconstrained", text="Free")
         col.prop(s, "constraint_weight")
         layout.prop(s, "quick_drags")
+        layout.prop(s, "enabled")
+        layout.prop(s, "strength", slider=True)
         row = layout.row(align=True)
         row.operator("specdeform.bind")
         row.operator("specdeform.unbind")

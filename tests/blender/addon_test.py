@@ -197,6 +197,84 @@ def check_polygons():
     assert np.array_equal(support.evaluated(obj), co)
 
 
+def check_strength(obj):
+    """Strength mixes rest and pose (keyframable), Enabled off shows the rest, as a modifier's
+    toggles; both leave the pose to come back."""
+    rest = support.evaluated(obj)
+    support.bind(obj)
+    T = np.eye(4)
+    T[:3, 3] = (0, 0, 0.5)
+    support.move(obj.specdeform.target, T)
+    pose = support.evaluated(obj)
+    assert np.abs(pose - rest).max() > 0.1
+    tolerance = 1e-5 * support.diagonal(rest)
+    s = obj.specdeform
+    for strength in (0.5, 0.0, 1.0):
+        s.strength = strength
+        bpy.context.view_layer.update()
+        want = rest + strength * (pose - rest)
+        assert np.abs(support.evaluated(obj) - want).max() <= tolerance, strength
+    s.enabled = False
+    bpy.context.view_layer.update()
+    assert np.array_equal(support.evaluated(obj), rest), "disabled: the rest"
+    s.enabled = True
+    bpy.context.view_layer.update()
+    assert np.abs(support.evaluated(obj) - pose).max() <= tolerance, "enabled: the pose again"
+    scene = bpy.context.scene
+    for frame, strength in ((1, 0.0), (11, 1.0)):
+        s.strength = strength
+        obj.keyframe_insert("specdeform.strength", frame=frame)
+    scene.frame_set(6)
+    halfway = rest + s.strength * (pose - rest)
+    assert 0.3 < s.strength < 0.7 and np.abs(support.evaluated(obj) - halfway).max() <= tolerance
+    scene.frame_set(1)
+    assert np.abs(support.evaluated(obj) - rest).max() <= tolerance, "keyframed 0: the rest"
+    obj.animation_data_clear()
+    s.strength = 1.0
+    assert bpy.ops.specdeform.apply() == {"FINISHED"}
+
+
+def check_shape_keys():
+    """A mesh with a shape key binds; the pose lives in a key of its own, so the artist's key
+    still moves its vertices on top of it; Strength mixes rest and pose; Unbind removes the key."""
+    V, F = specdeform.bumpy_bar(cells_per_unit=6)
+    handle, fixed = np.flatnonzero(V[:, 0] > 3.6), np.flatnonzero(V[:, 0] < 0.4)
+    obj, empty = support.add_object("keyed", V, F, handle, fixed)
+    rest = support.evaluated(obj)
+    tolerance = 1e-5 * support.diagonal(rest)
+    obj.shape_key_add(name="Basis", from_mix=False)
+    bulge = obj.shape_key_add(name="bulge", from_mix=False)
+    middle = np.flatnonzero(np.abs(V[:, 0] - 2) < 0.3)
+    co = rest.copy()
+    co[middle, 2] += 0.2
+    bulge.data.foreach_set("co", co.ravel())
+    bulge.value = 1.0
+    support.bind(obj)
+    assert np.abs(support.evaluated(obj) - co).max() <= tolerance, "binding moved the mesh"
+    T = np.eye(4)
+    T[:3, 3] = (0, 0.5, 0.3)
+    support.move(empty, T)
+    posed = support.evaluated(obj)
+    miss = np.linalg.norm(posed[handle] - support.apply_transform(T, rest[handle]), axis=1).max()
+    assert miss <= 0.005 * support.diagonal(rest), miss
+    print(f"shape keys: handle miss {miss / support.diagonal(rest):.2e} of the diagonal")
+    bulge.value = 0.0
+    bpy.context.view_layer.update()
+    pose = support.evaluated(obj)
+    offset = posed - pose
+    assert np.abs(offset[middle, 2] - 0.2).max() <= 1e-5, "the key moves its vertices"
+    assert np.abs(np.delete(offset, middle, 0)).max() <= 1e-6, "and no other"
+    for strength in (0.5, 0.0):
+        obj.specdeform.strength = strength
+        bpy.context.view_layer.update()
+        want = rest + strength * (pose - rest)
+        assert np.abs(support.evaluated(obj) - want).max() <= tolerance, strength
+    bulge.value = 1.0
+    assert bpy.ops.specdeform.unbind() == {"FINISHED"}
+    assert "specdeform" not in obj.data.shape_keys.key_blocks
+    assert np.abs(support.evaluated(obj) - co).max() <= 1e-6, "unbind: the basis and the key"
+
+
 def check_modifier_apply():
     """Applying a Subdivision Surface while posed: the subdivided pose stays (unbound, said in one
     line), never the pose applied twice; moving the target back changes nothing."""
@@ -267,12 +345,14 @@ def main():
     with tempfile.TemporaryDirectory() as workdir:
         os.environ["XDG_CACHE_HOME"] = workdir  # a fresh basis cache
         obj = check_deform(SCENE, *scene, workdir)
+        check_strength(obj)
         check_refusals(obj)
         check_cancel(obj)
         if SCENE == "generated":
             check_polygons()
             check_loose_parts()
             check_modifier_apply()
+            check_shape_keys()
     print("passed")
 
 
