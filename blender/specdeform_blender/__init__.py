@@ -40,6 +40,7 @@ _handlers = (
     (bpy.app.handlers.depsgraph_update_post, handlers.follow_targets),
     (bpy.app.handlers.frame_change_post, handlers.follow_targets),
     (bpy.app.handlers.load_post, handlers.bind_loaded),
+    (bpy.app.handlers.save_pre, handlers.finish_before_saving),
 )
 
 

@@ -92,3 +92,17 @@ def bind_loaded(*_):
     for obj in bpy.data.objects:
         if obj.type == "MESH" and obj.specdeform.bound:
             _bind_again(obj)
+
+
+@bpy.app.handlers.persistent
+def finish_before_saving(*_):
+    """save_pre: a pose shown with its details as displacements (a quick drag, or the transfer
+    still being factored) is solved in full first, so that the file holds the pose its reopening
+    computes (the load handler solves in full)."""
+    for obj in bpy.data.objects:
+        b = binding.binding(obj) if obj.type == "MESH" and obj.specdeform.bound else None
+        if b is not None and not b.exact:
+            try:
+                binding.finish(obj)
+            except library.specdeform.Error as e:
+                b.status["error"] = str(e)
