@@ -45,6 +45,7 @@ export function corners(r: Rect): Point[] {
 export function verticesIn(viewer: Viewer, contains: (x: number, y: number) => boolean, xray: boolean, diagonal: number): number[] {
   const p = viewer.positions();
   const camera = viewer.camera;
+  camera.updateMatrixWorld(); // moved since the last draw, perhaps
   const bounds = viewer.canvas.getBoundingClientRect();
   const v = new THREE.Vector3();
   const out: number[] = [];

@@ -203,7 +203,9 @@ export class EditorState {
     ++this.seq;
     this.sentAt.set(this.seq, performance.now());
     this.outstanding = this.seq;
-    this.connection.send(P.encodeFrame(this.seq, this.groups.map((g) => rowMajor(g.transform)), preview));
+    // The groups the server has (a new group is sent with its first vertices).
+    const groups = this.groups.slice(0, this.server?.groups.length ?? this.groups.length);
+    this.connection.send(P.encodeFrame(this.seq, groups.map((g) => rowMajor(g.transform)), preview));
   }
 
   get lastSeq(): number {
@@ -341,6 +343,7 @@ export class EditorState {
       case 'error':
         if (STATE_REQUESTS.has(m.request)) this.awaitingStates = Math.max(0, this.awaitingStates - 1);
         if (m.request === 'selection') this.selectionAnswered();
+        if (m.request === 'frame') this.outstanding = null; // answered, if not by a frame
         this.note(m.cancelled || m.message.startsWith(`${m.request}:`) ? m.message : `${requestName(m.request)}: ${m.message}`,
           m.cancelled ? 'info' : 'error');
         this.phase = this.ready ? { kind: 'ready' } : { kind: 'empty' };

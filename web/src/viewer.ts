@@ -408,6 +408,7 @@ export class Viewer {
 
   // A world point's position in client (CSS pixel) coordinates.
   toScreen(point: THREE.Vector3): { x: number; y: number } {
+    this.camera.updateMatrixWorld();
     const rect = this.canvas.getBoundingClientRect();
     const v = point.clone().project(this.camera);
     return { x: rect.left + ((v.x + 1) / 2) * rect.width, y: rect.top + ((1 - v.y) / 2) * rect.height };
@@ -608,7 +609,10 @@ export class Viewer {
     this.lookFrom(near.axis);
   }
 
+  // Client coordinates in the camera's normalised device coordinates. The camera's matrices are
+  // brought up to date first: a view key or a drag moves the camera before the next draw would.
   private ndc(clientX: number, clientY: number): THREE.Vector2 {
+    this.camera.updateMatrixWorld();
     const rect = this.canvas.getBoundingClientRect();
     return new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
   }
