@@ -234,8 +234,7 @@ class Request:
 def _check(obj):
     """Why the settings cannot be bound, or None: each line names the panel's field to fix."""
     s, groups = obj.specdeform, obj.vertex_groups
-    for i, (group, target, _) in enumerate(handles(obj)):
-        field = "Handle" if i == 0 else f"More handles, row {i}"
+    for i, ((group, target, _), field) in enumerate(zip(handles(obj), _fields(obj))):
         if not group:
             if len(groups) == 0:
                 return (f"{field}: the mesh has no vertex groups; add one with the vertices to "
