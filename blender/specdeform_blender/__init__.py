@@ -21,7 +21,7 @@ import atexit
 
 import bpy
 
-from . import bake, binding, handlers, operators, properties, ui
+from . import bake, binding, handlers, operators, properties, tasks, ui
 
 classes = (
     properties.SpecdeformHandle,
@@ -31,6 +31,7 @@ classes = (
     operators.SPECDEFORM_OT_apply,
     operators.SPECDEFORM_OT_handle_add,
     operators.SPECDEFORM_OT_handle_remove,
+    tasks.SPECDEFORM_OT_watch,
     bake.SPECDEFORM_OT_bake,
     bake.SPECDEFORM_OT_bake_pose,
     ui.SPECDEFORM_UL_handles,
@@ -41,6 +42,7 @@ _handlers = (
     (bpy.app.handlers.frame_change_post, handlers.follow_targets),
     (bpy.app.handlers.load_post, handlers.bind_loaded),
     (bpy.app.handlers.save_pre, handlers.finish_before_saving),
+    (bpy.app.handlers.render_init, tasks.finish_all),
 )
 
 
@@ -57,6 +59,7 @@ def unregister():
     atexit.unregister(binding.shutdown)
     for handler_list, handler in _handlers:
         handler_list.remove(handler)
+    tasks.shutdown()
     binding.shutdown()
     del bpy.types.Object.specdeform
     for cls in reversed(classes):

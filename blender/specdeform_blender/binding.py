@@ -1,11 +1,8 @@
-"""A bound object: Bind's input read from the object (Request), its basis computed or loaded on a
-worker thread (BasisJob), the deformer made from both (bind), and the mesh following its targets
-(update)."""
+"""A bound object: its settings checked, the deformer Bind made (preparing.py) attached to it, and
+the mesh following its targets (update)."""
 
 import contextlib
 import functools
-import os
-import threading
 import time
 from dataclasses import dataclass, field
 
@@ -42,12 +39,17 @@ class Binding:
 _bindings = {}  # Object.name_full -> Binding (a renamed object is bound again from the file)
 problems = {}  # Object.name_full -> why a bound object has no binding (one line)
 notices = {}  # Object.name_full -> what the add-on did on its own (unbound, one line)
-_jobs = set()  # BasisJobs whose thread still runs (computing, or saving the cache)
+jobs = set()  # preparing.BindJobs whose thread still runs (binding, or saving the cache)
 
 
 def binding(obj):
     """The object's binding while its settings say bound (undo past Bind leaves one in memory)."""
     return _bindings.get(obj.name_full) if obj.specdeform.bound else None
+
+
+def forget(obj):
+    """The object's binding dropped (bound again next)."""
+    _bindings.pop(obj.name_full, None)
 
 
 def forget_all():
@@ -63,7 +65,7 @@ def shutdown():
     library are still whole. A worker thread still inside the library when Python finalises is
     ended mid-call, which aborts Blender ("terminate called without an active exception", seen
     after a test's Bind whose basis was still being saved)."""
-    for job in list(_jobs):
+    for job in list(jobs):
         job.cancel()
         job._thread.join()
     forget_all()
@@ -138,6 +140,13 @@ def _finish_later(name):
     return None
 
 
+def _finish_later_once(obj, b, first_interval):
+    if not b.finishing:
+        b.finishing = True
+        bpy.app.timers.register(functools.partial(_finish_later, obj.name_full),
+                                first_interval=first_interval)
+
+
 def finish(obj):
     """The mesh with the full details of its pose (Apply, Bake Pose): waits for the transfer
     where it is being factored and solves again where the mesh shows displacements."""
@@ -194,10 +203,7 @@ def update(obj, b, depsgraph=None, full=False):
         st.pop("detail", None)
     if not b.exact:
         b.moved = solved
-        if not b.finishing:
-            b.finishing = True
-            bpy.app.timers.register(functools.partial(_finish_later, obj.name_full),
-                                    first_interval=0.2 if pending else SETTLE_S)
+        _finish_later_once(obj, b, 0.2 if pending else SETTLE_S)
     st["iterations"] = b.deformer.report.get("iterations", 0)
     st["solve_ms"] = 1e3 * (solved - start)
     st["quick"] = quick
@@ -214,34 +220,17 @@ def _write(obj, b):
         mesh_helpers.show(obj.data, shown)
 
 
-@dataclass
-class Request:
-    """What Bind reads from the object and its settings: the mesh (request), then, while the
-    worker computes the basis, the handles and fixed vertices (select)."""
-
-    rest: np.ndarray
-    used: np.ndarray
-    renumber: np.ndarray  # each vertex's index in the deformer's numbering (-1: in no face)
-    V: np.ndarray
-    F: np.ndarray
-    modes: int
-    eigensolver: str
-    groups: list = None  # vertex indices (deformer's numbering) of each handle group of the scene
-    levels: list = None  # (handle, weight) of each
-    fixed: np.ndarray = None
-
-
-def _check(obj):
+def check(obj):
     """Why the settings cannot be bound, or None: each line names the panel's field to fix."""
     s, groups = obj.specdeform, obj.vertex_groups
-    for i, ((group, target, _), field) in enumerate(zip(handles(obj), _fields(obj))):
+    for i, ((group, target, _), label) in enumerate(zip(handles(obj), fields(obj))):
         if not group:
             if len(groups) == 0:
-                return (f"{field}: the mesh has no vertex groups; add one with the vertices to "
+                return (f"{label}: the mesh has no vertex groups; add one with the vertices to "
                         "move (Object Data properties, Vertex Groups) and pick it")
-            return f"{field}: pick the vertex group to move"
+            return f"{label}: pick the vertex group to move"
         if group not in groups:
-            return f"{field}: this mesh has no vertex group '{group}'"
+            return f"{label}: this mesh has no vertex group '{group}'"
         if target is None or target == obj:
             what = "Target" if i == 0 else f"More handles, row {i}, target"
             return (f"{what}: choose the object that moves the handle (normally an Empty), "
@@ -254,13 +243,13 @@ def _check(obj):
     return None
 
 
-def _levels(h, indices, weights):
+def levels(h, indices, weights):
     """The handle's vertices split by weight (rounded to WEIGHT_STEP, at least one step)."""
     rounded = np.maximum(np.round(weights / WEIGHT_STEP), 1) * WEIGHT_STEP
     return [(indices[rounded == w], (h, float(w))) for w in np.unique(rounded)]
 
 
-def _shared(names, fields, members):
+def shared(names, fields, members):
     """Two of the groups (handles, fixed) that share vertices, said in one line naming the
     field to change, or None."""
     for i, a in enumerate(names):
@@ -275,142 +264,9 @@ def _shared(names, fields, members):
     return None
 
 
-def _fields(obj):
+def fields(obj):
     """The panel's name of each handle's field, then the fixed group's."""
     return ["Handle"] + [f"More handles, row {i}" for i in range(1, len(handles(obj)))] + ["Fixed"]
-
-
-def request(obj):
-    """Bind's mesh from `obj` (its saved rest when it is bound already), or an error message."""
-    s = obj.specdeform
-    problem = _check(obj)
-    if problem:
-        return problem
-    mesh = obj.data
-    rest = mesh_helpers.saved_rest(mesh) if s.bound else None
-    if rest is None:
-        rest = mesh_helpers.rest_coordinates(mesh)
-    F = mesh_helpers.triangles(mesh)
-    if len(F) == 0:
-        return "the mesh has no faces"
-    used = np.flatnonzero(np.bincount(F.ravel(), minlength=len(rest)))  # loose ones stay put
-    if s.modes > len(used):
-        return f"Modes is {s.modes}, more than the mesh's {len(used)} vertices: lower Modes"
-    renumber = np.full(len(rest), -1, np.int64)
-    renumber[used] = np.arange(len(used))
-    return Request(rest, used, renumber, rest[used].astype(np.float64),
-                   renumber[F].astype(np.int32), s.modes, s.eigensolver)
-
-
-def select(obj, r):
-    """The request's handle groups, their weights' levels and the fixed vertices, from the vertex
-    groups (read vertex by vertex: a third of a second at 692k vertices, which Bind spends while
-    the worker computes the basis); an error message, or None."""
-    s = obj.specdeform
-    names = [group for group, _, _ in handles(obj)] + [s.fixed_group] * bool(s.fixed_group)
-    fields = _fields(obj)[:len(names)]
-    weights = mesh_helpers.group_weights(obj, set(names))
-    members = {}
-    for name, (indices, w) in weights.items():
-        keep = r.renumber[indices] >= 0
-        if not keep.any():
-            return f"{fields[names.index(name)]}: vertex group '{name}' holds no vertex of a face"
-        members[name] = (r.renumber[indices][keep], w[keep])
-    problem = _shared(names, fields, members)
-    if problem:
-        return problem
-    split = [x for h, (group, _, _) in enumerate(handles(obj)) for x in _levels(h, *members[group])]
-    r.groups, r.levels = [g for g, _ in split], [level for _, level in split]
-    r.fixed = members[s.fixed_group][0] if s.fixed_group else np.empty(0, np.int64)
-    return None
-
-
-def start(obj):
-    """Bind's request and its basis job (started before the vertex groups are read), or an error
-    message."""
-    r = request(obj)
-    if isinstance(r, str):
-        return r
-    job = BasisJob(r)
-    problem = select(obj, r)
-    if problem:
-        job.cancel()
-        return problem
-    return r, job
-
-
-class _Cancelled(Exception):
-    pass
-
-
-class BasisJob:
-    """A Request's basis computed, or loaded from the cache, on a worker thread (the module
-    releases the GIL); cancel() stops it at the solver's next progress report. A computed basis
-    is done before it is saved in the cache: the thread saves it afterwards, while Bind goes on
-    (`saving`; 553 MB at 692k vertices, seconds that Bind does not wait for)."""
-
-    def __init__(self, request):
-        self.fraction, self.stage, self.result, self.error = 0.0, "starting", None, None
-        self.start, self.seconds = time.perf_counter(), 0.0
-        self.saving = False
-        self._cancel, self._done = threading.Event(), threading.Event()
-        self._thread = threading.Thread(target=self._run, args=(request,), daemon=True)
-        _jobs.add(self)
-        self._thread.start()
-
-    def _progress(self, fraction, stage):
-        if self._cancel.is_set():
-            raise _Cancelled
-        self.fraction, self.stage = fraction, stage
-
-    def _run(self, r):
-        sd = library.specdeform
-        try:
-            os.makedirs(library.cache_dir(), exist_ok=True)
-            file = sd.basis_cache_file(
-                r.V, r.F, r.modes, cache=library.cache_dir(), eigensolver=r.eigensolver
-            )
-            cached = os.path.exists(file)
-            self.result = sd.manifold_harmonics(
-                r.V, r.F, r.modes, cache=file if cached else None, eigensolver=r.eigensolver,
-                progress=self._progress,
-            )
-            self.saving = not cached and self.result[1].base.converged
-        except _Cancelled:
-            self.error = "cancelled"
-        except Exception as e:  # said in the panel; Bind never waits for a thread that died
-            self.error = str(e)
-        finally:
-            self.seconds = time.perf_counter() - self.start
-            self._done.set()
-        if self.saving:
-            if hasattr(os, "setpriority"):  # the lowest priority: Bind and Blender keep the cores
-                os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), 19)
-            try:
-                sd.save_basis(file, self.result, r.V, r.F)
-            except (sd.Error, OSError) as e:
-                print(f"specdeform: warning: basis not cached: {e}")
-            self.saving = False
-        _jobs.discard(self)
-
-    def cancel(self):
-        self._cancel.set()
-
-    def join(self, timeout=None):
-        self._done.wait(timeout)
-        return self
-
-    @property
-    def done(self):
-        return self._done.is_set()
-
-    def progress_text(self):
-        """'basis: <stage> 40%, about 12 s left' (the estimate once a tenth is done)."""
-        elapsed = time.perf_counter() - self.start
-        text = f"basis: {self.stage} {100 * self.fraction:.0f}%"
-        if self.fraction >= 0.1:
-            text += f", about {elapsed * (1 - self.fraction) / self.fraction:.0f} s left"
-        return text
 
 
 def _basis_line(evals, h):
@@ -428,38 +284,19 @@ def _basis_line(evals, h):
     return line
 
 
-def bind(obj, r, job):
-    """Binds `obj` to the basis `job` computed. Returns an error message, or None."""
-    if job.error:
-        return f"bind: {job.error}"
+def attach(obj, r, job, seconds, keep_shown=False):
+    """Binds `obj` to the deformer `job` built (`seconds` since Bind began) and poses it (a pose
+    the deformer refuses is said in the status). `keep_shown`: the mesh shows the pose of its
+    targets as they were when Bind began (a file reopened, the object renamed); if they did not
+    move since, that pose stays shown until the full details are ready, rather than displacements
+    meanwhile. Returns None, as Bind's other steps do."""
     s = obj.specdeform
-    sd = library.specdeform
-    start = time.perf_counter()
     evals, evecs = job.result
-    try:
-        d = sd.SpectralDeformer(
-            r.V,
-            r.F,
-            basis=(evals, evecs),
-            energy=s.energy,
-            detail=s.detail,
-            unconstrained=s.unconstrained,
-            constraint_weight=s.constraint_weight,
-            background_transfer=True,  # the details as displacements until it is factored
-            float32_basis=True,  # Blender's coordinates are float32: half the inverse transform
-        )
-        d.set_selection(handles=r.groups, fixed=r.fixed)
-    except sd.Error as e:
-        return str(e)
-    h = evecs.base
-    status = {
-        "basis_s": job.seconds,
-        "bind_s": job.seconds + time.perf_counter() - start,
-        "basis": _basis_line(evals, h),
-    }
+    status = {"basis_s": job.basis_seconds, "bind_s": seconds,
+              "basis": _basis_line(evals, evecs.base)}
     # All vertices in faces: a slice, which numpy writes ten times faster than an index array.
     used = slice(None) if len(r.used) == len(r.rest) else r.used
-    b = Binding(d, r.rest, used, r.levels, positions=r.rest.copy(), status=status)
+    b = Binding(job.deformer, r.rest, used, r.levels, positions=r.rest.copy(), status=status)
     if not s.bound:  # the input stays as it is until a target moves
         mesh_helpers.save_rest(obj.data, r.rest)
         mesh_helpers.add_pose_key(obj)
@@ -468,25 +305,19 @@ def bind(obj, r, job):
             owner.bound_matrix = [x for row in in_target for x in row]
         s.bound = True
         b.last = local_transforms(obj)
+    elif keep_shown and s.enabled and s.strength == 1.0 and np.array_equal(
+            local_transforms(obj), r.transforms):
+        b.positions = mesh_helpers.shown(obj.data)
+        b.last, b.exact = r.transforms, False
+        _finish_later_once(obj, b, 0.2)
     _bindings[obj.name_full] = b
     notices.pop(obj.name_full, None)
     problems.pop(obj.name_full, None)
-    update(obj, b)
+    try:
+        update(obj, b)
+    except library.specdeform.Error as e:
+        b.status["error"] = str(e)
     return None
-
-
-def bind_now(obj, report=None):
-    """Bind's whole pipeline on this thread (scripts, the load handler, leaving Edit Mode);
-    report(text) is called every second with the progress. Returns an error message, or None."""
-    started = start(obj)
-    if isinstance(started, str):
-        return started
-    r, job = started
-    while not job.done:
-        job.join(1.0)
-        if report and not job.done:
-            report(job.progress_text())
-    return bind(obj, r, job)
 
 
 def release(obj):

@@ -87,17 +87,15 @@ def triangles(mesh):
     return tris.reshape(-1, 3)
 
 
-def group_weights(obj, names):
-    """{name: (vertex indices, weights)} of the vertex groups `names`, weights above 0 (one loop
-    over the vertices, at Bind only: Blender 3.4 has no bulk access to vertex group weights)."""
-    index = {obj.vertex_groups[name].index: name for name in names}
-    found = {name: ([], []) for name in names}
-    for v in obj.data.vertices:
+def add_group_weights(vertices, index, found):
+    """The weights above 0 of the vertex groups `index` maps (group index -> name) over `vertices`
+    (a slice of the mesh's: Bind reads a chunk at a time), added to found[name] = (indices,
+    weights). A loop over the vertices: Blender 3.4 has no bulk access to vertex group weights."""
+    for v in vertices:
         for g in v.groups:
             if g.group in index and g.weight > 0:
                 found[index[g.group]][0].append(v.index)
                 found[index[g.group]][1].append(g.weight)
-    return {name: (np.array(i, np.int64), np.array(w)) for name, (i, w) in found.items()}
 
 
 def save_rest(mesh, co):

@@ -2,7 +2,7 @@
 
 import bpy
 
-from . import binding, library, mesh_helpers
+from . import binding, library, mesh_helpers, preparing, tasks
 
 
 def _poll_mesh(context):
@@ -10,7 +10,7 @@ def _poll_mesh(context):
     return library.specdeform is not None and obj is not None and obj.type == "MESH"
 
 
-class SPECDEFORM_OT_bind(bpy.types.Operator):
+class SPECDEFORM_OT_bind(tasks.Watcher, bpy.types.Operator):
     """Compute (or load from the cache) the mesh's harmonics and follow the target"""
 
     bl_idname = "specdeform.bind"
@@ -19,42 +19,28 @@ class SPECDEFORM_OT_bind(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        ready = _poll_mesh(context) and context.mode == "OBJECT"
-        return ready and binding.binding(context.object) is None  # greyed out while bound
+        obj = context.object
+        ready = _poll_mesh(context) and context.mode == "OBJECT" and tasks.running(obj) is None
+        return ready and binding.binding(obj) is None  # greyed out while bound
 
     def execute(self, context):
-        return self._done(binding.bind_now(context.object))
+        return self._said(preparing.bind_now(context.object))
 
     def invoke(self, context, _event):
-        """From the panel: the basis on a worker thread, progress in the status bar, Esc to
-        cancel."""
-        self.obj = context.object
-        started = binding.start(self.obj)
-        if isinstance(started, str):
-            return self._done(started)
-        self.r, self.job = started
-        wm = context.window_manager
-        wm.progress_begin(0, 100)
-        self.timer = wm.event_timer_add(0.1, window=context.window)
-        wm.modal_handler_add(self)
-        return {"RUNNING_MODAL"}
+        """From the panel: a task (the window stays free), its progress in the panel, Esc to
+        cancel; the operator ends with the bind (one undo step)."""
+        if not tasks.in_window():
+            return self.execute(context)
+        self.task = tasks.start(context.object, lambda _obj, _error: None)
+        return self._said(self.task.error) if self.task.finished else self.watch(context)
 
-    def modal(self, context, event):
-        if event.type == "ESC":
-            self.job.cancel()
-        if event.type != "TIMER":
-            return {"RUNNING_MODAL"}
-        wm = context.window_manager
-        wm.progress_update(int(100 * self.job.fraction))
-        context.workspace.status_text_set(f"specdeform: {self.job.progress_text()} (Esc cancels)")
-        if not self.job.done:
-            return {"RUNNING_MODAL"}
-        wm.event_timer_remove(self.timer)
-        wm.progress_end()
-        context.workspace.status_text_set(None)
-        return self._done(binding.bind(self.obj, self.r, self.job))
+    def ended(self):
+        return self.task.finished
 
-    def _done(self, error):
+    def end(self):
+        return self._said(self.task.error)
+
+    def _said(self, error):
         if error:
             self.report({"ERROR"}, error)
             return {"CANCELLED"}
@@ -74,6 +60,7 @@ class SPECDEFORM_OT_unbind(bpy.types.Operator):
 
     def execute(self, context):
         obj = context.object
+        tasks.cancel(obj)
         rest = mesh_helpers.saved_rest(obj.data)
         if rest is None:
             self.report({"ERROR"}, "the input coordinates are gone (the mesh was edited)")
@@ -96,6 +83,7 @@ class SPECDEFORM_OT_apply(bpy.types.Operator):
 
     def execute(self, context):
         obj = context.object
+        tasks.finish(obj)
         binding.finish(obj)
         binding.release(obj)
         key = mesh_helpers.pose_key(obj.data)

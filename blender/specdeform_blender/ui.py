@@ -5,7 +5,7 @@ import textwrap
 
 import bpy
 
-from . import binding, library
+from . import binding, library, tasks
 
 # Average width of a character of the panel's text, in pixels at UI scale 1 (Blender's default
 # font at its default size), and the panel's margins.
@@ -34,6 +34,10 @@ class SPECDEFORM_UL_handles(bpy.types.UIList):
 
 def _status(context, layout, obj, s):
     b = binding.binding(obj)
+    task = tasks.running(obj)
+    if task is not None:
+        _say(context, layout, f"{task.text()}; meanwhile {task.showing} (Esc cancels)", "TIME")
+        return
     if obj.name_full in binding.problems:
         _say(context, layout, binding.problems[obj.name_full], "ERROR")
     elif s.bound and b is None:

@@ -415,7 +415,9 @@ try {
     await page.mouse.down();
     await page.mouse.move(middle.x + 30, middle.y, { steps: 3 });
     await page.mouse.up();
-    await page.waitForFunction(() => window.specdeformEditor.counts().handles > 0, null, { timeout: 30000 });
+    // The stroke's brush queries answer after the release: its labels are read once it ended.
+    await page.waitForFunction(() => window.specdeformEditor.counts().handles > 0 &&
+      !window.specdeformEditor.unsettled().waits.includes('a stroke'), null, { timeout: 30000 });
     const painted = await api(() => ({ labels: window.specdeformEditor.labels(), phase: window.specdeformEditor.phase }));
     const handles = painted.labels.filter((l) => l === 2).length;
     log(`${handles} handle vertices painted, phase ${painted.phase}`);

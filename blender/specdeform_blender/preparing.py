@@ -1,0 +1,301 @@
+"""Bind's pipeline in steps, so that Bind, a file reopened and Edit Mode left never hold the
+window: Blender's main thread does what only it may (the settings and the rest, the triangles,
+the vertex groups chunk by chunk, then attaching the deformer to the object: each step at most a
+few tenths of a second at 692k vertices), and a worker thread the rest (the mesh renumbered, the
+basis computed or loaded from the cache, the selection checked, the deformer built). `steps()`
+is a generator that yields between the main thread's steps; a timer drives it in a window
+(tasks.py), `bind_now()` at once (scripts, `blender -b`, renders)."""
+
+import os
+import threading
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import binding, library, mesh_helpers
+
+GROUP_CHUNK = 100_000  # vertices whose vertex groups one step reads (0.17 s at 692k)
+# Triangles: up to TRIANGLES_AT_ONCE read in one step by foreach_get (0.63 s for 1.38M headless,
+# up to 1.07 s in a window: Blender 3.4 has no faster read of a mesh's faces); more a chunk a step
+# (0.15 s each, 3 times foreach_get's total time).
+TRIANGLES_AT_ONCE = 300_000
+TRIANGLE_CHUNK = 50_000
+CANCELLED = "bind: cancelled"
+CHANGED = "Object Data: the mesh changed while it was being bound; press Bind again"
+
+
+@dataclass
+class Request:
+    """What Bind reads from the object on the main thread (rest, triangles, settings, vertex
+    groups), and what the worker thread makes of it in the deformer's numbering."""
+
+    rest: np.ndarray  # float32 (n, 3), every vertex
+    triangles: np.ndarray  # int32 (f, 3), Blender's numbering
+    modes: int
+    eigensolver: str
+    options: dict  # the deformer's keywords
+    names: list  # the vertex group of each handle, then the fixed group's (if any)
+    fields: list  # the panel's field of each of `names`
+    fixed: bool  # the last of `names` is the fixed group
+    transforms: np.ndarray  # the targets' (binding.local_transforms) when Bind began
+    weights: dict = None  # name -> (vertex indices, weights), Blender's numbering
+    # Made by the worker thread:
+    used: np.ndarray = None  # the vertices the faces use
+    renumber: np.ndarray = None  # each vertex's index in the deformer's numbering (-1: in no face)
+    V: np.ndarray = None  # float64 (m, 3): the used vertices' rest
+    F: np.ndarray = None  # int32 (f, 3): the triangles in the deformer's numbering
+    groups: list = None  # vertex indices (deformer's numbering) of each handle group of the scene
+    levels: list = None  # (handle, weight) of each
+    fixed_vertices: np.ndarray = None
+
+
+def request(obj):
+    """Bind's settings and rest from `obj` (its saved rest when it is bound already), or an error
+    message; the triangles and the vertex groups are read by the next steps."""
+    s = obj.specdeform
+    problem = binding.check(obj)
+    if problem:
+        return problem
+    rest = mesh_helpers.saved_rest(obj.data) if s.bound else None
+    if rest is None:
+        rest = mesh_helpers.rest_coordinates(obj.data)
+    names = [group for group, _, _ in binding.handles(obj)] + [s.fixed_group] * bool(s.fixed_group)
+    options = {"energy": s.energy, "detail": s.detail, "unconstrained": s.unconstrained,
+               "constraint_weight": s.constraint_weight}
+    return Request(rest, None, s.modes, s.eigensolver, options, names,
+                   binding.fields(obj)[:len(names)], bool(s.fixed_group),
+                   binding.local_transforms(obj) if s.bound else None)
+
+
+def _group_weights(obj, names):
+    """Generator: the weights of the vertex groups `names` (mesh_helpers.add_group_weights),
+    GROUP_CHUNK vertices a step; each resumption passes the object again (an undo replaces it).
+    Returns the object as last passed and the weights, or an error message."""
+    n = len(obj.data.vertices)
+    index = {obj.vertex_groups[name].index: name for name in names}
+    found = {name: ([], []) for name in names}
+    for start in range(0, n, GROUP_CHUNK):
+        if len(obj.data.vertices) != n:
+            return obj, CHANGED
+        mesh_helpers.add_group_weights(obj.data.vertices[start:start + GROUP_CHUNK], index, found)
+        obj = yield "reading the vertex groups", min(n, start + GROUP_CHUNK) / n
+    return obj, {name: (np.array(i, np.int64), np.array(w)) for name, (i, w) in found.items()}
+
+
+def _triangles(obj, at_once):
+    """Generator: mesh_helpers.triangles, a chunk a step on a large mesh unless `at_once`.
+    Returns the object as last passed and the triangles, or an error message."""
+    mesh = obj.data
+    mesh.calc_loop_triangles()
+    n = len(mesh.loop_triangles)
+    if at_once or n <= TRIANGLES_AT_ONCE:
+        return obj, mesh_helpers.triangles(mesh)
+    out = np.empty((n, 3), np.int32)
+    for start in range(0, n, TRIANGLE_CHUNK):
+        chunk = mesh.loop_triangles[start:start + TRIANGLE_CHUNK]
+        out[start:start + len(chunk)] = [t.vertices[:] for t in chunk]
+        obj = yield "reading the triangles", min(n, start + TRIANGLE_CHUNK) / n
+        mesh = obj.data
+        if len(mesh.loop_triangles) != n:
+            return obj, CHANGED
+    return obj, out
+
+
+def _renumber(r):
+    """The deformer's numbering: the vertices the faces use (loose ones stay put); an error
+    message, or None."""
+    used = np.flatnonzero(np.bincount(r.triangles.ravel(), minlength=len(r.rest)))
+    if r.modes > len(used):
+        return f"Modes is {r.modes}, more than the mesh's {len(used)} vertices: lower Modes"
+    r.used = used
+    r.renumber = np.full(len(r.rest), -1, np.int64)
+    r.renumber[used] = np.arange(len(used))
+    return None
+
+
+def _select(r, handle_count):
+    """The request's handle groups split by their weights' levels and the fixed vertices, in the
+    deformer's numbering; an error message, or None."""
+    members = {}
+    for name, (indices, w) in r.weights.items():
+        keep = r.renumber[indices] >= 0
+        if not keep.any():
+            field = r.fields[r.names.index(name)]
+            return f"{field}: vertex group '{name}' holds no vertex of a face"
+        members[name] = (r.renumber[indices][keep], w[keep])
+    problem = binding.shared(r.names, r.fields, members)
+    if problem:
+        return problem
+    split = [x for h in range(handle_count) for x in binding.levels(h, *members[r.names[h]])]
+    r.groups, r.levels = [g for g, _ in split], [level for _, level in split]
+    r.fixed_vertices = members[r.names[-1]][0] if r.fixed else np.empty(0, np.int64)
+    return None
+
+
+class _Cancelled(Exception):
+    pass
+
+
+class BindJob:
+    """The worker thread of one Bind: the request renumbered, its basis computed or loaded from
+    the cache (the module releases the GIL), then, once the main thread has read the vertex
+    groups (selected()), the selection checked and the deformer built. cancel() stops it at the
+    solver's next progress report or between stages; the caller does not wait for that (a
+    deformer being built is finished and dropped). A computed basis is saved in the cache after
+    `done` (`saving`; 553 MB at 692k vertices, seconds that Bind does not wait for)."""
+
+    def __init__(self, request, handle_count):
+        self.fraction, self.stage, self.basis_done = 0.0, "starting", False
+        self.result = self.deformer = self.error = None
+        self.start, self.basis_seconds = time.perf_counter(), 0.0
+        self.saving = False
+        self._cancel, self._selected, self._done = (threading.Event(), threading.Event(),
+                                                    threading.Event())
+        self._thread = threading.Thread(target=self._run, args=(request, handle_count),
+                                        daemon=True)
+        binding.jobs.add(self)
+        self._thread.start()
+
+    def _progress(self, fraction, stage):
+        if self._cancel.is_set():
+            raise _Cancelled
+        self.fraction, self.stage = fraction, stage
+
+    def _basis(self, r, file):
+        sd = library.specdeform
+        cached = os.path.exists(file)
+        self.result = sd.manifold_harmonics(
+            r.V, r.F, r.modes, cache=file if cached else None, eigensolver=r.eigensolver,
+            progress=self._progress)
+        self.basis_seconds = time.perf_counter() - self.start
+        self.basis_done, self.stage = True, "building the deformer"  # said without "basis:"
+        self.saving = not cached and self.result[1].base.converged
+
+    def _deformer(self, r):
+        sd = library.specdeform
+        self._progress(1.0, "building the deformer")
+        d = sd.SpectralDeformer(
+            r.V, r.F, basis=self.result, **r.options,
+            background_transfer=True,  # the details as displacements until it is factored
+            float32_basis=True,  # Blender's coordinates are float32: half the inverse transform
+        )
+        d.set_selection(handles=r.groups, fixed=r.fixed_vertices)
+        self._progress(1.0, "posing")
+        return d
+
+    def _run(self, r, handle_count):
+        sd = library.specdeform
+        file = None
+        try:
+            self.error = _renumber(r)
+            if self.error is None:
+                r.V = r.rest[r.used].astype(np.float64)
+                r.F = r.renumber[r.triangles].astype(np.int32)
+                os.makedirs(library.cache_dir(), exist_ok=True)
+                file = sd.basis_cache_file(r.V, r.F, r.modes, cache=library.cache_dir(),
+                                           eigensolver=r.eigensolver)
+                self._basis(r, file)
+                while not self._selected.wait(0.05):
+                    self._progress(1.0, "reading the vertex groups")
+                self.error = _select(r, handle_count) if r.weights is not None else CANCELLED
+            if self.error is None:
+                self.deformer = self._deformer(r)
+                self._progress(1.0, "posing")
+        except _Cancelled:
+            self.error = CANCELLED
+        except Exception as e:  # said in the panel; Bind never waits for a thread that died
+            self.error = f"bind: {e}"
+        finally:
+            self.saving = self.saving and not self._cancel.is_set()  # a cancel leaves nothing
+            self._done.set()
+        if self.saving:
+            if hasattr(os, "setpriority"):  # the lowest priority: Bind and Blender keep the cores
+                os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), 19)
+            try:
+                sd.save_basis(file, self.result, r.V, r.F)
+            except (sd.Error, OSError) as e:
+                print(f"specdeform: warning: basis not cached: {e}")
+            self.saving = False
+        binding.jobs.discard(self)
+
+    def selected(self):
+        """The main thread has read the vertex groups (or given up: request.weights None)."""
+        self._selected.set()
+
+    def cancel(self):
+        self._cancel.set()
+        self._selected.set()
+
+    def join(self, timeout=None):
+        self._done.wait(timeout)
+        return self
+
+    @property
+    def done(self):
+        return self._done.is_set()
+
+    def progress_text(self):
+        """'basis: <stage> 40%, about 12 s left' (the estimate once a tenth is done)."""
+        if self.basis_done:
+            return self.stage
+        elapsed = time.perf_counter() - self.start
+        text = f"basis: {self.stage} {100 * self.fraction:.0f}%"
+        if self.fraction >= 0.1:
+            text += f", about {elapsed * (1 - self.fraction) / self.fraction:.0f} s left"
+        return text
+
+
+def steps(obj, keep_shown=False, at_once=False):
+    """Bind's pipeline as a generator. Each `yield` ends a main-thread step with what is being
+    done (the stage and the fraction done) or the job being waited for; the driver resumes it
+    with the object looked up again (`send(obj)`) and closes it to cancel. keep_shown: see
+    binding.attach; at_once: no chunks where they cost time (nothing waits for the thread).
+    Returns an error message, or None."""
+    started = time.perf_counter()
+    r = request(obj)
+    if isinstance(r, str):
+        return r
+    obj = yield "reading the triangles", 0.0
+    obj, triangles = yield from _triangles(obj, at_once)
+    if isinstance(triangles, str):
+        return triangles
+    if len(triangles) == 0:
+        return "Object Data: the mesh has no faces"
+    r.triangles = triangles
+    if len(obj.data.vertices) != len(r.rest):
+        return CHANGED
+    job = BindJob(r, len(binding.handles(obj)))
+    try:
+        obj = yield "reading the vertex groups", 0.0
+        obj, weights = yield from _group_weights(obj, r.names)
+        if isinstance(weights, str):
+            return weights
+        r.weights = weights
+        job.selected()
+        while not job.done:
+            obj = yield job
+    finally:
+        if not job.done:  # closed (cancelled) or failed: the thread stops at its next report
+            job.cancel()
+    if job.error:
+        return job.error
+    if len(obj.data.vertices) != len(r.rest):
+        return CHANGED
+    return binding.attach(obj, r, job, time.perf_counter() - started, keep_shown)
+
+
+def bind_now(obj, report=None, keep_shown=False):
+    """Bind's whole pipeline at once (scripts, `blender -b`, renders); report(text) is called
+    every second while the worker runs. Returns an error message, or None."""
+    pipeline = steps(obj, keep_shown, at_once=True)
+    try:
+        waiting = next(pipeline)
+        while True:
+            if isinstance(waiting, BindJob):
+                waiting.join(1.0)
+                if report and not waiting.done:
+                    report(waiting.progress_text())
+            waiting = pipeline.send(obj)
+    except StopIteration as end:
+        return end.value
