@@ -46,7 +46,7 @@ def esc():
     return time.perf_counter() - start
 
 
-def until(condition, seconds=120):
+def until(condition, seconds=240):
     start = time.perf_counter()
     while not condition():
         assert time.perf_counter() - start < seconds, "timed out"
