@@ -220,6 +220,15 @@ def _write(obj, b):
         mesh_helpers.show(obj.data, shown)
 
 
+def hold_targets(obj):
+    """Bind begins: each handle's object-in-target matrix, which makes the targets' transforms
+    since then (local_transforms) the pose; moving a target while Bind runs poses the mesh once
+    it is bound."""
+    for _, target, owner in handles(obj):
+        in_target = target.matrix_world.inverted() @ obj.matrix_world
+        owner.bound_matrix = [x for row in in_target for x in row]
+
+
 def check(obj):
     """Why the settings cannot be bound, or None: each line names the panel's field to fix."""
     s, groups = obj.specdeform, obj.vertex_groups
@@ -297,14 +306,11 @@ def attach(obj, r, job, seconds, keep_shown=False):
     # All vertices in faces: a slice, which numpy writes ten times faster than an index array.
     used = slice(None) if len(r.used) == len(r.rest) else r.used
     b = Binding(job.deformer, r.rest, used, r.levels, positions=r.rest.copy(), status=status)
-    if not s.bound:  # the input stays as it is until a target moves
+    if not s.bound:  # the input stays as it is until a target moves (since Bind began)
         mesh_helpers.save_rest(obj.data, r.rest)
         mesh_helpers.add_pose_key(obj)
-        for _, target, owner in handles(obj):
-            in_target = target.matrix_world.inverted() @ obj.matrix_world
-            owner.bound_matrix = [x for row in in_target for x in row]
         s.bound = True
-        b.last = local_transforms(obj)
+        b.last = r.transforms
     elif keep_shown and s.enabled and s.strength == 1.0 and np.array_equal(
             local_transforms(obj), r.transforms):
         b.positions = mesh_helpers.shown(obj.data)

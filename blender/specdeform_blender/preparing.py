@@ -38,7 +38,7 @@ class Request:
     names: list  # the vertex group of each handle, then the fixed group's (if any)
     fields: list  # the panel's field of each of `names`
     fixed: bool  # the last of `names` is the fixed group
-    transforms: np.ndarray  # the targets' (binding.local_transforms) when Bind began
+    transforms: np.ndarray  # the targets' (binding.local_transforms) as Bind began
     weights: dict = None  # name -> (vertex indices, weights), Blender's numbering
     # Made by the worker thread:
     used: np.ndarray = None  # the vertices the faces use
@@ -63,9 +63,11 @@ def request(obj):
     names = [group for group, _, _ in binding.handles(obj)] + [s.fixed_group] * bool(s.fixed_group)
     options = {"energy": s.energy, "detail": s.detail, "unconstrained": s.unconstrained,
                "constraint_weight": s.constraint_weight}
+    if not s.bound:
+        binding.hold_targets(obj)
     return Request(rest, None, s.modes, s.eigensolver, options, names,
                    binding.fields(obj)[:len(names)], bool(s.fixed_group),
-                   binding.local_transforms(obj) if s.bound else None)
+                   binding.local_transforms(obj))
 
 
 def _group_weights(obj, names):

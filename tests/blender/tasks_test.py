@@ -139,6 +139,23 @@ def check_edit_mode(obj, rest, pose, diagonal):
     assert np.abs(support.evaluated(obj) - pose).max() <= 1e-5 * diagonal
 
 
+def check_target_moved_while_binding(obj, empty, rest, diagonal, handle):
+    """A target moved while Bind runs: the rest is the pose as Bind began, so the mesh, once
+    bound, follows the move (its handle at the target, 0.5% of the diagonal)."""
+    assert bpy.ops.specdeform.unbind() == {"FINISHED"}
+    support.move(empty, np.eye(4))
+    task = tasks.start(obj, lambda _obj, _error: None)
+    tasks._tick()
+    T = np.eye(4)
+    T[:3, 3] = (0, -0.4, 0.2)
+    support.move(empty, T)
+    drive(task, rest, diagonal)
+    assert task.error is None and obj.specdeform.bound, task.error
+    X = support.evaluated(obj)
+    miss = np.linalg.norm(X[handle] - support.apply_transform(T, rest[handle]), axis=1).max()
+    assert miss <= 0.005 * diagonal, miss / diagonal
+
+
 def main():
     V, F = specdeform.bumpy_bar(cells_per_unit=24)
     handle, fixed = np.flatnonzero(V[:, 0] > 3.6), np.flatnonzero(V[:, 0] < 0.4)
@@ -157,6 +174,7 @@ def main():
         check_bound_again(obj, pose, diagonal)
         check_cancel_everywhere(obj, pose, diagonal)
         check_edit_mode(obj, rest, pose, diagonal)
+        check_target_moved_while_binding(obj, empty, rest, diagonal, handle)
         workers_stop()
     print("passed")
 
