@@ -298,7 +298,7 @@ def attach(obj, r, job, seconds, keep_shown=False):
     the deformer refuses is said in the status). `keep_shown`: the mesh shows the pose of its
     targets as they were when Bind began (a file reopened, the object renamed); if they did not
     move since, that pose stays shown until the full details are ready, rather than displacements
-    meanwhile. Returns None, as Bind's other steps do."""
+    meanwhile."""
     s = obj.specdeform
     evals, evecs = job.result
     status = {"basis_s": job.basis_seconds, "bind_s": seconds,
@@ -323,7 +323,6 @@ def attach(obj, r, job, seconds, keep_shown=False):
         update(obj, b)
     except library.specdeform.Error as e:
         b.status["error"] = str(e)
-    return None
 
 
 def release(obj):

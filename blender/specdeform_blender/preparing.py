@@ -51,7 +51,8 @@ class Request:
 
 
 def request(obj):
-    """Bind's settings and rest from `obj` (its saved rest when it is bound already), or an error
+    """Bind's settings, rest and targets from `obj` (its saved rest when it is bound already; on
+    a first Bind the targets are held as they are now, binding.hold_targets), or an error
     message; the triangles and the vertex groups are read by the next steps."""
     s = obj.specdeform
     problem = binding.check(obj)
@@ -171,7 +172,7 @@ class BindJob:
             r.V, r.F, r.modes, cache=file if cached else None, eigensolver=r.eigensolver,
             progress=self._progress)
         self.basis_seconds = time.perf_counter() - self.start
-        self.basis_done, self.stage = True, "building the deformer"  # said without "basis:"
+        self.basis_done = True  # the stages after it are said without "basis:"
         self.saving = not cached and self.result[1].base.converged
 
     def _deformer(self, r):
@@ -198,12 +199,12 @@ class BindJob:
                 file = sd.basis_cache_file(r.V, r.F, r.modes, cache=library.cache_dir(),
                                            eigensolver=r.eigensolver)
                 self._basis(r, file)
-                while not self._selected.wait(0.05):
+                while not self._selected.is_set():
                     self._progress(1.0, "reading the vertex groups")
+                    self._selected.wait(0.05)
                 self.error = _select(r, handle_count) if r.weights is not None else CANCELLED
             if self.error is None:
                 self.deformer = self._deformer(r)
-                self._progress(1.0, "posing")
         except _Cancelled:
             self.error = CANCELLED
         except Exception as e:  # said in the panel; Bind never waits for a thread that died
@@ -284,7 +285,8 @@ def steps(obj, keep_shown=False, at_once=False):
         return job.error
     if len(obj.data.vertices) != len(r.rest):
         return CHANGED
-    return binding.attach(obj, r, job, time.perf_counter() - started, keep_shown)
+    binding.attach(obj, r, job, time.perf_counter() - started, keep_shown)
+    return None
 
 
 def bind_now(obj, report=None, keep_shown=False):
