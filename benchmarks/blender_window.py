@@ -49,7 +49,7 @@ if "--make" in args:
     make(args[0], args[args.index("--make") + 1])
     sys.exit(0)
 
-from specdeform_blender import binding, handlers, tasks  # noqa: E402
+from specdeform_blender import binding, editing, tasks  # noqa: E402
 
 if not BASELINE:
     support.specdeform_blender.register()
@@ -75,7 +75,7 @@ def timed(function, label):
 
 
 tasks.Task.step = timed(tasks.Task.step, lambda task: task.text().split(" · ")[0])
-handlers._show_rest = timed(handlers._show_rest, lambda *_: "Edit Mode: the rest shown")
+editing.show_rest = timed(editing.show_rest, lambda *_: "Edit Mode: the rest shown")
 binding._finish_later = timed(binding._finish_later, lambda _: "the full details")
 
 

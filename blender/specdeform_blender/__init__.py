@@ -41,6 +41,8 @@ _handlers = (
     (bpy.app.handlers.depsgraph_update_post, handlers.follow_targets),
     (bpy.app.handlers.frame_change_post, handlers.follow_targets),
     (bpy.app.handlers.load_post, handlers.bind_loaded),
+    (bpy.app.handlers.undo_post, handlers.undone),
+    (bpy.app.handlers.redo_post, handlers.undone),
     (bpy.app.handlers.save_pre, handlers.finish_before_saving),
     (bpy.app.handlers.render_init, tasks.finish_all),
 )

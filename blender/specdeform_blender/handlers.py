@@ -3,57 +3,10 @@ each frame change (keyframes, drivers, `frame_set`, `blender -b -a` renders), on
 and out, and when a file is loaded (bound meshes bound again without a click, in the background in
 a window: tasks.py)."""
 
-import bmesh
 import bpy
+import numpy as np
 
-from . import binding, library, mesh_helpers, preparing, tasks
-
-_editing = set()  # Object.name_full: Edit Mode entered while the object was being bound again
-
-
-def _show_rest(obj, rest=None):
-    """Entering Edit Mode: the edit mesh shows the rest shape, which the edits change: `rest`, or
-    the one saved in the mesh (its attribute is a layer of the edit mesh in Edit Mode)."""
-    bm = bmesh.from_edit_mesh(obj.data)
-    if rest is None:
-        layer = bm.verts.layers.float_vector.get(mesh_helpers.REST)
-        rest = [v[layer].copy() for v in bm.verts] if layer is not None else []
-    else:
-        rest = rest.tolist()
-    if len(bm.verts) == len(rest):
-        for v, co in zip(bm.verts, rest):
-            v.co = co
-        bmesh.update_edit_mesh(obj.data, loop_triangles=False, destructive=False)
-
-
-def _edit_while_binding(obj):
-    """Edit Mode entered while the object is bound again: that bind is dropped, the edit mesh
-    shows the rest (not the saved pose), and leaving Edit Mode binds again from the edited rest."""
-    _editing.add(obj.name_full)
-    tasks.cancel(obj)
-    _show_rest(obj)
-
-
-def _rebind_edited(obj):
-    """Leaving Edit Mode: the mesh as edited is the new rest, shown until it is bound again from
-    it (the basis from the cache when the mesh did not change) and posed again."""
-    _editing.discard(obj.name_full)
-    mesh_helpers.save_rest(obj.data, mesh_helpers.rest_coordinates(obj.data))
-    binding.forget(obj)
-    tasks.start(obj, _bound_again_edited, showing="the mesh shows its edited rest shape")
-
-
-def _bound_again_edited(obj, error):
-    if obj is None or obj.name_full in _editing:
-        return
-    if error == preparing.CANCELLED:
-        binding.problems[obj.name_full] = ("Edit Mode: binding again cancelled; the mesh shows "
-                                           "its edited rest shape: Bind poses it")
-    elif error:
-        binding.problems[obj.name_full] = f"Edit Mode: {error}"
-    else:
-        binding.binding(obj).status["note"] = "Bound again from the edited rest shape"
-
+from . import binding, editing, library, mesh_helpers, preparing, tasks
 
 def _changed_outside(obj, before):
     """The mesh's vertices changed in number outside Edit Mode (a modifier applied, Join,
@@ -69,11 +22,10 @@ def _changed_outside(obj, before):
 def _follow(obj, b, depsgraph):
     if obj.mode == "EDIT":
         if not b.editing:
-            _show_rest(obj, b.rest)
-            b.editing = True
+            editing.enter(obj, b)
         return
     if b.editing:
-        _rebind_edited(obj)
+        editing.leave(obj)
         return
     if len(b.rest) != len(obj.data.vertices):
         _changed_outside(obj, len(b.rest))
@@ -96,10 +48,10 @@ def follow_targets(scene, depsgraph):
             continue
         if tasks.running(obj):
             if obj.mode == "EDIT":
-                _edit_while_binding(obj)
-        elif obj.name_full in _editing:
+                editing.enter_while_binding(obj)
+        elif editing.pending(obj):
             if obj.mode != "EDIT":
-                _rebind_edited(obj)
+                editing.leave(obj)
         elif binding.binding(obj) is None:
             if obj.name_full not in binding.problems:
                 _bind_again(obj)
@@ -116,7 +68,7 @@ def _bind_again(obj):
 
 
 def _bound_again(obj, error):
-    if obj is None or not error or obj.name_full in _editing:
+    if obj is None or not error or editing.pending(obj):
         return
     if error == preparing.CANCELLED:
         error = "Binding again cancelled: the mesh shows its saved pose; Bind resumes"
@@ -130,12 +82,43 @@ def bind_loaded(*_):
     basis from the cache, or computed), as they were posed."""
     tasks.cancel_all()  # the last file's
     binding.forget_all()
-    _editing.clear()
+    editing.clear()
     if library.specdeform is None:
         return
     for obj in bpy.data.objects:
         if obj.type == "MESH" and obj.specdeform.bound:
             _bind_again(obj)
+
+
+@bpy.app.handlers.persistent
+def undone(*_):
+    """undo_post and redo_post: Blender gave back another state of the file, every object and
+    mesh as it was then (a bound mesh shows the pose of that state), which the add-on follows:
+    - a bind running for a mesh now in Edit Mode, or bound since it began or no longer bound, is
+      cancelled (the others check before attaching that the rest they read is still the mesh's);
+    - Edit Mode, and the step of leaving it: editing.undone_to;
+    - a binding whose rest is not the one its mesh saved (a modifier's apply or Edit Mode
+      undone) is dropped, and the mesh bound again from the rest it saved, showing the pose
+      undone to; the others solve again for their targets as they were;
+    - what was said of an object is forgotten, but for the failures of the bound meshes still
+      without a binding."""
+    binding.notices.clear()
+    for task in tasks.all_running():
+        obj = bpy.data.objects.get(task.name)
+        if obj is not None and (obj.mode == "EDIT" or obj.specdeform.bound != task.bound):
+            task.cancel()
+            binding.problems.pop(task.name, None)
+    for obj in bpy.data.objects:
+        if obj.type != "MESH" or not obj.specdeform.bound:
+            binding.problems.pop(obj.name_full, None)
+            continue
+        b = binding.binding(obj)
+        if editing.undone_to(obj, b) or b is None:
+            continue
+        if b.editing or not np.array_equal(mesh_helpers.saved_rest(obj.data), b.rest):
+            binding.forget(obj)
+        else:
+            b.last = None
 
 
 @bpy.app.handlers.persistent

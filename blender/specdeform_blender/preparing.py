@@ -58,9 +58,7 @@ def request(obj):
     problem = binding.check(obj)
     if problem:
         return problem
-    rest = mesh_helpers.saved_rest(obj.data) if s.bound else None
-    if rest is None:
-        rest = mesh_helpers.rest_coordinates(obj.data)
+    rest = _rest(obj)
     names = [group for group, _, _ in binding.handles(obj)] + [s.fixed_group] * bool(s.fixed_group)
     options = {"energy": s.energy, "detail": s.detail, "unconstrained": s.unconstrained,
                "constraint_weight": s.constraint_weight}
@@ -69,6 +67,13 @@ def request(obj):
     return Request(rest, None, s.modes, s.eigensolver, options, names,
                    binding.fields(obj)[:len(names)], bool(s.fixed_group),
                    binding.local_transforms(obj))
+
+
+def _rest(obj):
+    """The rest Bind starts from: the one saved when the object was bound (binding it again), or
+    the mesh's own."""
+    rest = mesh_helpers.saved_rest(obj.data) if obj.specdeform.bound else None
+    return mesh_helpers.rest_coordinates(obj.data) if rest is None else rest
 
 
 def _group_weights(obj, names):
@@ -283,8 +288,8 @@ def steps(obj, keep_shown=False, at_once=False):
             job.cancel()
     if job.error:
         return job.error
-    if len(obj.data.vertices) != len(r.rest):
-        return CHANGED
+    if len(obj.data.vertices) != len(r.rest) or not np.array_equal(_rest(obj), r.rest):
+        return CHANGED  # an undo, say
     binding.attach(obj, r, job, time.perf_counter() - started, keep_shown)
     return None
 

@@ -25,6 +25,7 @@ class Task:
 
     def __init__(self, obj, done, keep_shown, showing):
         self.name, self.done, self.showing = obj.name_full, done, showing
+        self.bound = obj.specdeform.bound  # binding again (not a first Bind)
         self.started = time.perf_counter()
         self.finished, self.error = False, None
         self._pipeline = preparing.steps(obj, keep_shown)
@@ -111,6 +112,10 @@ def cancel(obj, why=preparing.CANCELLED):
 def cancel_all(why=preparing.CANCELLED):
     for task in list(_tasks.values()):
         task.cancel(why)
+
+
+def all_running():
+    return list(_tasks.values())
 
 
 def finish(obj):

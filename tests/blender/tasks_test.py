@@ -2,7 +2,8 @@
 a bound mesh bound again (a reopened file) never holds Blender's thread long, shows its saved pose
 until it is posed again, and comes back at that pose; a cancel in every stage ends the bind at
 once, leaves the mesh as shown and says so, and its worker stops; Edit Mode entered while a mesh
-is bound again shows the rest and leaving it binds from the edited rest.
+is bound again shows the rest and leaving it binds from the edited rest; an Undo while a Bind
+runs.
 
     blender -b --factory-startup --python-exit-code 1 --python tasks_test.py
 Environment: SPECDEFORM_BLENDER_DIR, SPECDEFORM_PYTHON_DIR.
@@ -21,7 +22,7 @@ import bmesh  # noqa: E402
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import specdeform  # noqa: E402
-from specdeform_blender import binding, handlers, tasks  # noqa: E402
+from specdeform_blender import binding, handlers, preparing, tasks  # noqa: E402
 
 tasks.in_window = lambda: True  # binds run as tasks, as in a window
 CANCEL_S = 0.5  # the bar: a cancel gives Blender back within this
@@ -139,6 +140,30 @@ def check_edit_mode(obj, rest, pose, diagonal):
     assert np.abs(support.evaluated(obj) - pose).max() <= 1e-5 * diagonal
 
 
+def check_undo_while_binding(rest, pose, diagonal):
+    """Unbind, Bind again as a task, and Undo while it runs (which gives back the bound mesh
+    before Unbind): that Bind is cancelled, and the mesh bound again from its saved rest in the
+    background, showing the pose undone to meanwhile and after."""
+    bpy.context.view_layer.update()
+    assert bpy.ops.ed.undo_push(message="posed") == {"FINISHED"}
+    assert bpy.ops.specdeform.unbind("EXEC_DEFAULT", True) == {"FINISHED"}
+    first = tasks.start(bpy.data.objects["bar"], lambda _obj, _error: None)
+    tasks._tick()
+    assert bpy.ops.ed.undo() == {"FINISHED"}
+    bpy.context.view_layer.update()
+    obj = bpy.data.objects["bar"]  # an undo replaces the objects
+    assert first.finished and first.error == preparing.CANCELLED, first.error
+    assert obj.specdeform.bound, "Unbind not undone"
+    task = tasks.running(obj)
+    assert task is not None and task is not first, "not bound again after the undo"
+    drive(task, pose, diagonal)
+    assert task.error is None and binding.binding(obj) is not None, task.error
+    assert np.abs(support.evaluated(obj) - pose).max() <= 1e-6 * diagonal
+    support.move(bpy.data.objects["bar-target"], np.eye(4))
+    assert np.abs(support.evaluated(obj) - rest).max() <= 1e-6 * diagonal, "not from its rest"
+    return obj, bpy.data.objects["bar-target"]
+
+
 def check_target_moved_while_binding(obj, empty, rest, diagonal, handle):
     """A target moved while Bind runs: the rest is the pose as Bind began, so the mesh, once
     bound, follows the move (its handle at the target, 0.5% of the diagonal)."""
@@ -174,6 +199,7 @@ def main():
         check_bound_again(obj, pose, diagonal)
         check_cancel_everywhere(obj, pose, diagonal)
         check_edit_mode(obj, rest, pose, diagonal)
+        obj, empty = check_undo_while_binding(rest, pose, diagonal)
         check_target_moved_while_binding(obj, empty, rest, diagonal, handle)
         workers_stop()
     print("passed")
