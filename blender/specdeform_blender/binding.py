@@ -33,7 +33,13 @@ class Binding:
     full_ms: float = 0.0  # the last update with the full details took this long
     moved: float = 0.0  # time of the last update shown with displacements
     finishing: bool = False  # the timer that solves again with the full details is registered
+    written: bool = False  # the mesh shows what the add-on wrote last (checked before writing)
     status: dict = field(default_factory=dict)
+
+
+class ChangedOutside(Exception):
+    """The mesh no longer shows what the add-on wrote last: something else changed its
+    coordinates (a modifier applied that keeps the vertex count, Apply Scale, Sculpt Mode)."""
 
 
 _bindings = {}  # Object.name_full -> Binding (a renamed object is bound again from the file)
@@ -137,6 +143,8 @@ def _finish_later(name):
     except library.specdeform.Error as e:  # a singular Poisson system, say
         b.finishing = False
         b.status["error"] = str(e)
+    except ChangedOutside:
+        release_changed(obj)
     return None
 
 
@@ -152,7 +160,10 @@ def finish(obj):
     where it is being factored and solves again where the mesh shows displacements."""
     b = binding(obj)
     if b is not None and not b.exact:
-        update(obj, b, full=True)
+        try:
+            update(obj, b, full=True)
+        except ChangedOutside:
+            release_changed(obj)
 
 
 def update(obj, b, depsgraph=None, full=False):
@@ -165,16 +176,14 @@ def update(obj, b, depsgraph=None, full=False):
     final = full or _must_be_final()
     s = obj.specdeform
     mix = (s.enabled, s.strength)
-    if not s.enabled:  # the rest shown; solved again once enabled if the targets moved
+    same = b.last is not None and np.array_equal(transforms, b.last) and (b.exact or not final)
+    if not s.enabled or same:  # disabled: the rest, solved again once enabled if targets moved
         if b.mix != mix:
-            b.mix = mix
-            mesh_helpers.show(obj.data, b.rest)
-        return
-    if b.last is not None and np.array_equal(transforms, b.last) and (b.exact or not final):
-        if b.mix != mix:
+            _check_untouched(obj, b)
             b.mix = mix
             _write(obj, b)
         return
+    _check_untouched(obj, b)
     start = time.perf_counter()
     T = blend(transforms, b.levels)
     pending = b.deformer.detail_pending
@@ -210,14 +219,36 @@ def update(obj, b, depsgraph=None, full=False):
     st["write_ms"] = 1e3 * (time.perf_counter() - solved)
 
 
-def _write(obj, b):
-    """The mesh's coordinates: the pose, or rest + strength x (pose - rest)."""
-    strength = b.mix[1]
+def _shown(b):
+    """What the mix asks the mesh to show: the rest (disabled), the pose, or rest + strength x
+    (pose - rest)."""
+    enabled, strength = b.mix
+    if not enabled:
+        return b.rest
     if strength == 1.0:
-        mesh_helpers.show(obj.data, b.positions)
-    else:
-        shown = b.rest + np.float32(strength) * (b.positions - b.rest)
-        mesh_helpers.show(obj.data, shown)
+        return b.positions
+    return b.rest + np.float32(strength) * (b.positions - b.rest)
+
+
+def _write(obj, b):
+    mesh_helpers.show(obj.data, _shown(b))
+    b.written = True
+
+
+def _check_untouched(obj, b):
+    """Before writing: ChangedOutside where the mesh no longer shows what was written last
+    (the pose would overwrite the change)."""
+    if b.written and not np.array_equal(mesh_helpers.shown(obj.data), _shown(b)):
+        raise ChangedOutside
+
+
+def release_changed(obj, why=None):
+    """A bound mesh that no longer fits its binding, which shows a pose already: unbound, the
+    shape shown kept (binding again from it would pose it twice), `why` said in the panel."""
+    why = why or ("the mesh's shape was changed outside Edit Mode (a modifier applied, Apply "
+                  "Scale, Sculpt Mode)")
+    release(obj)
+    notices[obj.name_full] = f"Unbound: {why}; it keeps the shape shown. Bind to deform it again"
 
 
 def hold_targets(obj):
@@ -310,11 +341,11 @@ def attach(obj, r, job, seconds, keep_shown=False):
         mesh_helpers.save_rest(obj.data, r.rest)
         mesh_helpers.add_pose_key(obj)
         s.bound = True
-        b.last = r.transforms
+        b.last, b.written = r.transforms, True
     elif keep_shown and s.enabled and s.strength == 1.0 and np.array_equal(
             local_transforms(obj), r.transforms):
         b.positions = mesh_helpers.shown(obj.data)
-        b.last, b.exact = r.transforms, False
+        b.last, b.exact, b.written = r.transforms, False, True
         _finish_later_once(obj, b, 0.2)
     _bindings[obj.name_full] = b
     notices.pop(obj.name_full, None)

@@ -8,16 +8,6 @@ import numpy as np
 
 from . import binding, editing, library, mesh_helpers, preparing, tasks
 
-def _changed_outside(obj, before):
-    """The mesh's vertices changed in number outside Edit Mode (a modifier applied, Join,
-    Separate, Decimate): the binding no longer fits it and its shown shape is the pose already,
-    so it is unbound and kept as shown (binding again from it would pose it twice)."""
-    binding.release(obj)
-    binding.notices[obj.name_full] = (
-        f"Unbound: the mesh went from {before:,} to {len(obj.data.vertices):,} vertices outside "
-        "Edit Mode (a modifier applied, Join or Separate); it keeps the shape shown. Bind to "
-        "deform it again")
-
 
 def _follow(obj, b, depsgraph):
     if obj.mode == "EDIT":
@@ -27,14 +17,18 @@ def _follow(obj, b, depsgraph):
     if b.editing:
         editing.leave(obj)
         return
-    if len(b.rest) != len(obj.data.vertices):
-        _changed_outside(obj, len(b.rest))
+    if len(b.rest) != len(obj.data.vertices):  # a modifier applied, Join, Separate, Decimate
+        binding.release_changed(obj, f"the mesh went from {len(b.rest):,} to "
+                                f"{len(obj.data.vertices):,} vertices outside Edit Mode (a "
+                                "modifier applied, Join or Separate)")
         return
     if all(target for _, target, _ in binding.handles(obj)):
         try:
             binding.update(obj, b, depsgraph)
         except library.specdeform.Error as e:
             b.status["error"] = str(e)
+        except binding.ChangedOutside:
+            binding.release_changed(obj)
 
 
 @bpy.app.handlers.persistent
@@ -117,8 +111,8 @@ def undone(*_):
             continue
         if b.editing or not np.array_equal(mesh_helpers.saved_rest(obj.data), b.rest):
             binding.forget(obj)
-        else:
-            b.last = None
+        else:  # the mesh shows the pose of the state undone to: solved again
+            b.last, b.written = None, False
 
 
 @bpy.app.handlers.persistent

@@ -268,7 +268,8 @@ def check_shape_keys():
 
 def check_modifier_apply():
     """Applying a Subdivision Surface while posed: the subdivided pose stays (unbound, said in one
-    line), never the pose applied twice; moving the target back changes nothing."""
+    line), never the pose applied twice; moving the target back changes nothing. A Smooth
+    applied, and Apply Scale, alike."""
     V, F = specdeform.bumpy_bar(cells_per_unit=6)
     handle, fixed = np.flatnonzero(V[:, 0] > 3.6), np.flatnonzero(V[:, 0] < 0.4)
     obj, empty = support.add_object("applied", V, F, handle, fixed)
@@ -287,6 +288,33 @@ def check_modifier_apply():
     assert np.abs(support.evaluated(obj) - shown).max() <= 1e-6 * support.diagonal(shown)
     support.move(empty, np.eye(4))
     assert np.abs(support.evaluated(obj) - shown).max() <= 1e-6 * support.diagonal(shown)
+    # A modifier that keeps the vertex count (Smooth), and Apply Scale, change the shape shown
+    # without the add-on: at the next target move the mesh is unbound keeping that shape, said
+    # in one line, never overwritten by the pose (the change lost) nor posed from it.
+    for change in ("smooth", "scale"):
+        support.bind(obj)
+        support.move(empty, T)
+        if change == "smooth":
+            obj.modifiers.new("smooth", "SMOOTH").factor = 1.0
+            posed = support.evaluated(obj)
+            assert bpy.ops.object.modifier_apply(modifier="smooth") == {"FINISHED"}
+        else:
+            obj.scale = (2, 2, 2)
+            bpy.context.view_layer.update()
+            posed = 2 * support.evaluated(obj)
+            bpy.ops.object.select_all(action="DESELECT")
+            obj.select_set(True)
+            assert bpy.ops.object.transform_apply(scale=True) == {"FINISHED"}
+        bpy.context.view_layer.update()
+        changed = support.evaluated(obj)
+        assert np.abs(changed - posed).max() <= 1e-5 * support.diagonal(posed), change
+        support.move(empty, T @ T)
+        line = support.panel_lines(obj)[0]
+        assert not obj.specdeform.bound, f"{change}: still bound"
+        assert line.startswith("Unbound: the mesh's shape was changed outside Edit Mode"), line
+        assert np.abs(support.evaluated(obj) - changed).max() <= 1e-6 * support.diagonal(changed)
+        support.move(empty, np.eye(4))
+    print(f"changed outside the add-on: {line}")
     # A linked duplicate would write the same mesh as its original: refused, naming the fix.
     twin = obj.copy()
     bpy.context.collection.objects.link(twin)
