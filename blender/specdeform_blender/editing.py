@@ -20,7 +20,11 @@ _left = {}  # Object.name_full -> float32 (n, 3): the rest as edited, as Edit Mo
 def show_rest(obj, rest=None):
     """The edit mesh shows the rest shape, which the edits change: `rest`, or the one saved in
     the mesh (its attribute is a layer of the edit mesh in Edit Mode). Vertex by vertex: BMesh
-    has no bulk write."""
+    has no bulk write (1.7-1.9 s at 692k in a window). With shape keys there is nothing to do:
+    Edit Mode shows the active key, the Basis (the rest) unless the artist chose another key to
+    edit, which stays as it is."""
+    if mesh_helpers.pose_key(obj.data) is not None:
+        return
     bm = bmesh.from_edit_mesh(obj.data)
     if rest is None:
         layer = bm.verts.layers.float_vector.get(mesh_helpers.REST)

@@ -20,6 +20,7 @@ if SCENE == "mismatch":
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import support  # noqa: E402
 
+import bmesh  # noqa: E402
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 from specdeform_blender import library, ui  # noqa: E402
@@ -255,6 +256,21 @@ def check_shape_keys():
     offset = posed - pose
     assert np.abs(offset[middle, 2] - 0.2).max() <= 1e-5, "the key moves its vertices"
     assert np.abs(np.delete(offset, middle, 0)).max() <= 1e-6, "and no other"
+    # Edit Mode shows the active key: the Basis (the rest), or the artist's key chosen to edit,
+    # which leaving Edit Mode keeps as it was (not overwritten by the rest).
+    for index, want in ((0, rest), (1, co)):
+        obj.active_shape_key_index = index
+        bpy.ops.object.mode_set(mode="EDIT")
+        bpy.context.view_layer.update()
+        edit = np.array([v.co for v in bmesh.from_edit_mesh(obj.data).verts], np.float32)
+        assert np.abs(edit - want).max() <= 1e-6, f"Edit Mode with key {index} active"
+        bpy.ops.object.mode_set(mode="OBJECT")
+        bpy.context.view_layer.update()
+    keyed = np.empty(co.size, np.float32)
+    bulge.data.foreach_get("co", keyed)
+    assert np.abs(keyed - co.ravel()).max() <= 1e-6, "the artist's key changed in Edit Mode"
+    obj.active_shape_key_index = 0
+    assert np.abs(support.evaluated(obj) - pose).max() <= tolerance, "posed again"
     for strength in (0.5, 0.0):
         obj.specdeform.strength = strength
         bpy.context.view_layer.update()
