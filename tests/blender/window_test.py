@@ -2,6 +2,7 @@
 window keeps handling events, its progress in the panel, and Esc cancels it within 0.5 s, the mesh
 as it was; a reopened file's bound mesh is bound again in the background showing its saved pose,
 and Esc cancels that too, the panel saying how to resume; Bind resumes it at the saved pose.
+Undo gives back an Unbind and an Edit Mode edit, the mesh bound again from its rest.
 
     xvfb-run -a blender --factory-startup --enable-event-simulate --python window_test.py
 Environment: SPECDEFORM_BLENDER_DIR, SPECDEFORM_PYTHON_DIR. Exits 1 on a failed check.
@@ -16,6 +17,7 @@ import traceback
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import support  # noqa: E402
 
+import bmesh  # noqa: E402
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 import specdeform  # noqa: E402
@@ -67,6 +69,51 @@ def frames_settle():
 def stage(obj):
     task = tasks.running(obj)
     return task.text() if task else ""
+
+
+def bar():
+    return bpy.data.objects["bar"]  # looked up again: an undo replaces the objects
+
+
+def bound_again(shown, diagonal):
+    """Bound again in the background after an undo, the mesh showing `shown` meanwhile and
+    after."""
+    assert tasks.running(bar()) is not None, "not bound again in the background"
+    yield from until(lambda: binding.binding(bar()) is not None and binding.binding(bar()).exact)
+    assert np.abs(support.evaluated(bar()) - shown).max() <= 1e-6 * diagonal
+
+
+def check_undo(rest, pose, diagonal):
+    """Blender's Undo in the window: Unbind undone, and Edit Mode's edit undone back to the step
+    of entering it (whose edit mesh Blender saved showing the pose): each time the mesh is bound
+    again in the background from its rest, at the pose undone to; the target moved back gives
+    the rest."""
+    with window_context(bar()):
+        bpy.ops.ed.undo_push(message="posed")
+        assert bpy.ops.specdeform.unbind("EXEC_DEFAULT", True) == {"FINISHED"}
+    assert np.abs(support.evaluated(bar()) - rest).max() <= 1e-6 * diagonal
+    with window_context(bar()):
+        assert bpy.ops.ed.undo() == {"FINISHED"}
+    assert bar().specdeform.bound, "Unbind not undone"
+    yield from bound_again(pose, diagonal)
+
+    with window_context(bar()):
+        assert bpy.ops.object.mode_set("EXEC_DEFAULT", True, mode="EDIT") == {"FINISHED"}
+        assert bpy.ops.mesh.select_all(action="SELECT") == {"FINISHED"}
+        assert bpy.ops.transform.translate("EXEC_DEFAULT", True, value=(0, 0, 0.3)) == {
+            "FINISHED"}
+        assert bpy.ops.ed.undo() == {"FINISHED"}
+    yield 0.2
+    bm = bmesh.from_edit_mesh(bar().data)
+    edit = np.array([v.co for v in bm.verts], np.float32)
+    assert bar().mode == "EDIT" and np.abs(edit - rest).max() <= 1e-6 * diagonal, "not the rest"
+    with window_context(bar()):
+        assert bpy.ops.object.mode_set(mode="OBJECT") == {"FINISHED"}
+    yield 0.2
+    yield from bound_again(pose, diagonal)
+    support.move(bpy.data.objects["bar-target"], np.eye(4))
+    assert np.abs(support.evaluated(bar()) - rest).max() <= 1e-6 * diagonal, "not from the rest"
+    print("Undo in the window: Unbind and an Edit Mode edit undone, bound again from the rest")
 
 
 def script():
@@ -129,6 +176,7 @@ def script():
         bpy.ops.specdeform.bind("INVOKE_DEFAULT")
     yield from until(lambda: binding.binding(obj) is not None and binding.binding(obj).exact)
     assert np.abs(support.evaluated(obj) - pose).max() <= 1e-6 * diagonal
+    yield from check_undo(rest, pose, diagonal)
     print("passed")
     bpy.ops.wm.quit_blender()
 
