@@ -148,14 +148,4 @@ def script():
     bpy.ops.wm.quit_blender()
 
 
-run = script()
-
-
-def drive():
-    try:
-        return next(run)
-    except StopIteration:
-        return None
-
-
-bpy.app.timers.register(drive, first_interval=2.0, persistent=True)
+support.run_in_window(script, first_interval=2.0)

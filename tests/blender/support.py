@@ -3,6 +3,7 @@ folder (SPECDEFORM_BLENDER_DIR) and the compiled module (SPECDEFORM_PYTHON_DIR) 
 
 import os
 import sys
+import traceback
 
 for var in ("SPECDEFORM_BLENDER_DIR", "SPECDEFORM_PYTHON_DIR"):
     if os.environ.get(var):
@@ -122,3 +123,20 @@ def panel_lines(obj, width=100000):
                                    "preferences": bpy.context.preferences})()
     ui.VIEW3D_PT_specdeform.draw(panel, context)
     return panel.layout.labels
+
+
+def run_in_window(script, first_interval=1.0):
+    """Steps the generator `script` from a timer of Blender's window, each `yield s` waiting s
+    seconds while the window handles its events; a failure is printed and Blender exits 1."""
+    steps = script()
+
+    def drive():
+        try:
+            return next(steps)
+        except StopIteration:
+            return None
+        except Exception:
+            traceback.print_exc()
+            os._exit(1)
+
+    bpy.app.timers.register(drive, first_interval=first_interval, persistent=True)

@@ -12,7 +12,6 @@ import os
 import sys
 import tempfile
 import time
-import traceback
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import support  # noqa: E402
@@ -181,17 +180,4 @@ def script():
     bpy.ops.wm.quit_blender()
 
 
-steps = script()
-
-
-def drive():
-    try:
-        return next(steps)
-    except StopIteration:
-        return None
-    except Exception:
-        traceback.print_exc()
-        os._exit(1)
-
-
-bpy.app.timers.register(drive, first_interval=1.0, persistent=True)
+support.run_in_window(script)
