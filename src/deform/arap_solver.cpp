@@ -90,7 +90,10 @@ ArapState iterate(const Space& space, ArapState start, double scale, const ArapO
   Iterate current = local(std::move(start.x), std::move(start.rotations));
   const double floor = std::max(options.energy_floor * scale, 1e-14 * current.energy);
   std::vector<double> alpha;
-  while (r.iterations < options.max_iterations) {
+  // A start whose energy is rounding noise (the rest, a rigid motion) is the solution: a step
+  // would only move it by that noise.
+  r.converged = current.energy <= floor;
+  while (!r.converged && r.iterations < options.max_iterations) {
     ++r.iterations;
     Eigen::MatrixX3d direction = current.gradient;  // the two-loop recursion
     alpha.resize(history.size());

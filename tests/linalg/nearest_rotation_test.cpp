@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
@@ -39,6 +41,24 @@ TEST(NearestRotation, PolarFactorMirrorAndRankOne) {
   const Eigen::Matrix3d R = detail::nearest_rotation(rank_one);
   EXPECT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).norm(), 1e-12);
   EXPECT_NEAR(R.determinant(), 1.0, 1e-12);
+}
+
+// An ill-conditioned symmetric positive definite matrix (an ARAP cluster's rest covariance on a
+// mesh of slivers, eigenvalues 2.7e3, 4.4e4, 3.1e9) is its own symmetric factor: its nearest
+// rotation is the identity, and Q times it gives Q (the closed form on A^T A alone was off by up
+// to 70 degrees).
+TEST(NearestRotation, IllConditionedStretch) {
+  std::srand(7);
+  for (int trial = 0; trial < 200; ++trial) {
+    const Eigen::Matrix3d frame =
+        Eigen::Quaterniond(Eigen::Vector4d::Random().normalized()).toRotationMatrix();
+    const Eigen::Vector3d spread(2.7e3, 4.4e4, 3.1e9);
+    const Eigen::Matrix3d S = frame * spread.asDiagonal() * frame.transpose();
+    EXPECT_LT((detail::nearest_rotation(S) - Eigen::Matrix3d::Identity()).norm(), 1e-10) << S;
+    const Eigen::Matrix3d Q =
+        Eigen::AngleAxisd(0.3 * trial, Eigen::Vector3d::Random().normalized()).matrix();
+    EXPECT_LT((detail::nearest_rotation(Q * S) - Q).norm(), 1e-10);
+  }
 }
 
 }  // namespace

@@ -38,8 +38,9 @@
 // O(k m + m^2), independent of n. They stop when an iteration lowers the energy by less than
 // `tolerance` times the energy, or times `energy_floor` of the base's Dirichlet energy where the
 // energy is smaller (a piece that only moves rigidly has an energy of rounding noise: measured
-// against itself, its change would read as any number), when the energy falls below that floor,
-// or at `max_iterations`. Energies are in the units of the mesh's lengths squared, on the unit-area
+// against itself, its change would read as any number), when the energy falls below that floor
+// (a start already below it, such as the rest under identity transforms, takes no step and is
+// returned bit for bit), or at `max_iterations`. Energies are in the units of the mesh's lengths squared, on the unit-area
 // scale of deform_options.h.
 #pragma once
 

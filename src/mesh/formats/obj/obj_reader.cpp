@@ -1,6 +1,8 @@
+#include <algorithm>
 #include <array>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "linalg/parallel.h"
 #include "mesh/polygon_soup.h"
@@ -11,23 +13,52 @@ namespace specdeform::detail {
 
 namespace {
 
-// Joins lines ending in a backslash (OBJ line continuation) into one.
-std::string join_continued_lines(std::string_view data) {
-  std::string out;
-  out.reserve(data.size());
+// Lines ending in a backslash (OBJ line continuation) joined into one: the text, and where
+// each join put its blank (an offset in `text`) with the raw bytes it replaced.
+struct JoinedLines {
+  std::string text;
+  std::vector<size_t> at, replaced;
+};
+
+JoinedLines join_continued_lines(std::string_view data) {
+  JoinedLines out;
+  out.text.reserve(data.size());
   for (size_t i = 0; i < data.size(); ++i) {
     if (data[i] == '\\') {
       size_t j = i + 1;
       while (j < data.size() && (data[j] == ' ' || data[j] == '\t' || data[j] == '\r')) ++j;
       if (j == data.size() || data[j] == '\n') {
-        out += ' ';
+        out.at.push_back(out.text.size());
+        out.replaced.push_back(std::min(j + 1, data.size()) - i);
+        out.text += ' ';
         i = j;
         continue;
       }
     }
-    out += data[i];
+    out.text += data[i];
   }
   return out;
+}
+
+// Whether a join falls on a v or vn line (whose numbers a rewrite replaces).
+bool joins_a_vertex_line(const JoinedLines& joined) {
+  for (const size_t at : joined.at) {
+    const size_t newline = joined.text.rfind('\n', at);
+    std::string_view line = std::string_view(joined.text).substr(
+        newline == std::string::npos ? 0 : newline + 1);
+    while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
+    if (line.starts_with("v ") || line.starts_with("v\t") || line.starts_with("vn")) return true;
+  }
+  return false;
+}
+
+// The offsets of the joined text moved to the raw bytes' (`offsets` ascending).
+void to_raw_offsets(const JoinedLines& joined, std::vector<size_t>& offsets) {
+  size_t k = 0, shift = 0;
+  for (size_t& o : offsets) {
+    for (; k < joined.at.size() && joined.at[k] < o; ++k) shift += joined.replaced[k] - 1;
+    o += shift;
+  }
 }
 
 // The v, vt and vn lines of a part of the file.
@@ -262,13 +293,14 @@ void keep_record(ObjRecord&& r, std::string_view data, KeptRecord& keep) {
 // A large file is read in two halves at once, split at a line: the second half counts the
 // first's v, vt and vn lines before its own (for its indices); a failure in either is reported by
 // reading the file again from the start, whose message then names the face as a single pass
-// does (692k vertices: 0.20 -> 0.12 s). A kept file with line continuations keeps them joined.
+// does (692k vertices: 0.20 -> 0.12 s). A kept file keeps its line continuations, but where one
+// splits a v or vn line (the rewrite then writes that line joined).
 PolygonSoup parse_obj(std::string_view raw, const std::string& name, KeptRecord* keep) {
   constexpr size_t kSplitFrom = 8 << 20;  // bytes
-  const std::string joined = raw.find('\\') == std::string_view::npos
-                                 ? std::string()
+  const JoinedLines joined = raw.find('\\') == std::string_view::npos
+                                 ? JoinedLines()
                                  : join_continued_lines(raw);  // most files have none
-  const std::string_view data = joined.empty() ? raw : joined;
+  const std::string_view data = joined.at.empty() ? raw : std::string_view(joined.text);
   const size_t split =
       data.size() < kSplitFrom ? std::string_view::npos : data.find('\n', data.size() / 2);
   PolygonSoup soup;
@@ -300,7 +332,13 @@ PolygonSoup parse_obj(std::string_view raw, const std::string& name, KeptRecord*
   if (soup.num_vertices() == 0 && soup.num_polygons() == 0) {
     TextScanner(data, name).fail("empty file (no vertices)");
   }
-  if (keep) keep_record(std::move(first), data, *keep);
+  if (keep && !joined.at.empty() && !joins_a_vertex_line(joined)) {
+    to_raw_offsets(joined, first.v);
+    to_raw_offsets(joined, first.vn);
+    keep_record(std::move(first), raw, *keep);
+  } else if (keep) {
+    keep_record(std::move(first), data, *keep);
+  }
   // Some exporters (trimesh, scanners) write a position once per texture coordinate or normal
   // instead of indexing them apart: copies at one place are one vertex, or the seams open.
   soup.weld = weld_coincident(soup.xyz);
