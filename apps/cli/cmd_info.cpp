@@ -4,7 +4,9 @@
 #include <nlohmann/json.hpp>
 
 #include "common.h"
+#include "specdeform/exceptions.h"
 #include "specdeform/mesh/mesh_info.h"
+#include "specdeform/operators/laplacian.h"
 #include "specdeform/spectral/manifold_harmonics.h"
 
 namespace specdeform::cli {
@@ -12,14 +14,18 @@ namespace specdeform::cli {
 void add_info_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("info", "print a mesh's topology, geometry and defects");
   struct Args {
-    std::string path;
-    bool json = false;
+    std::string path, cache;
+    bool json = false, basis = false;
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("MESH", args->path, "mesh file (.obj .off .ply .stl .gltf .glb)")->required();
   cmd->add_flag("--json", args->json, "print one JSON object");
+  cmd->add_flag("--basis", args->basis,
+                "compute the basis deform would (default options), as deform's last check");
+  cmd->add_option("--basis-cache", args->cache,
+                  "with --basis: a basis cache file, read if it matches, written otherwise");
   cmd->callback([args] {
-    const auto& [path, json] = *args;
+    const auto& [path, cache, json, check_basis] = *args;
     const MeshFileReport report = inspect_mesh_file(path);
     const FileSummary& contents = report.contents;
     nlohmann::ordered_json j;
@@ -115,10 +121,35 @@ void add_info_command(CLI::App& app) {
     }
     if (!contents.properties.empty()) j["properties"] = contents.properties;
     j["round_trip_keeps"] = contents.round_trip;
+    // deform's checks of the mesh before any selection: its operators (mollified where it needs
+    // it) finite with an area at every vertex; with --basis, the basis itself.
     nlohmann::ordered_json deform = {{"ok", true}};
+    std::string refused;
+    try {
+      const LaplacianOperators L =
+          laplacian_operators(loaded.mesh, MassType::Lumped, LaplacianType::Cotan);
+      check_operators(L.stiffness, L.mass, "the Laplacian");
+    } catch (const Error& e) {
+      refused = e.what();
+      deform = {{"ok", false}, {"refused", refused}};
+    }
     if (!contents.changes.empty()) deform["writing_changes"] = contents.changes;
     const int modes = default_modes(loaded.mesh.num_vertices());
     if (modes < ManifoldHarmonicsOptions{}.num_modes) deform["default_modes"] = modes;
+    deform["checked"] = check_basis ? "the mesh, its operators and the basis"
+                                    : "the mesh and its operators (--basis: the basis too)";
+    if (check_basis && refused.empty()) {
+      ManifoldHarmonicsOptions h;
+      h.num_modes = modes;
+      h.solver = default_eigensolver(loaded.mesh.num_vertices(), h.policy);
+      try {
+        const auto basis = obtain_basis(loaded.mesh, h, cache);
+        deform["basis"] = residual_summary(*basis);
+      } catch (const Error& e) {
+        deform["ok"] = false;
+        deform["refused"] = e.what();
+      }
+    }
     j["deform"] = deform;
     print();
   });

@@ -4,8 +4,7 @@
 #include <Eigen/SVD>
 
 #include "specdeform/exceptions.h"
-#include "specdeform/operators/cotan_laplacian.h"
-#include "specdeform/operators/mass_matrix.h"
+#include "specdeform/operators/laplacian.h"
 
 namespace specdeform::server {
 
@@ -46,7 +45,8 @@ FittedTransform fit_transform(const Vertices& rest, const Vertices& current,
 }
 
 ManifoldHarmonics reuse_basis(const TriangleMesh& mesh, const ManifoldHarmonics& basis) {
-  const Eigen::SparseMatrix<double> K = cotan_stiffness(mesh), M = mass_matrix(mesh, basis.mass);
+  const LaplacianOperators L = laplacian_operators(mesh, basis.mass, basis.laplacian);
+  const Eigen::SparseMatrix<double>&K = L.stiffness, &M = L.mass;
   const Eigen::MatrixXd& H = basis.basis;
   const Eigen::MatrixXd A = H.transpose() * (K * H), B = H.transpose() * (M * H);
   const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (A + A.transpose()),
@@ -54,6 +54,7 @@ ManifoldHarmonics reuse_basis(const TriangleMesh& mesh, const ManifoldHarmonics&
   if (eig.info() != Eigen::Success) throw SolverError("apply pose: Rayleigh-Ritz failed");
   ManifoldHarmonics out;
   out.mass = basis.mass;
+  out.laplacian = basis.laplacian;
   out.eigenvalues = eig.eigenvalues().cwiseMax(0.0);
   out.basis = H * eig.eigenvectors();
   out.max_residual = eigen_residual(K, M, out.basis, out.eigenvalues);

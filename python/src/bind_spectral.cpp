@@ -8,7 +8,7 @@
 #include "convert.h"
 #include "harmonics.h"
 #include "specdeform/exceptions.h"
-#include "specdeform/operators/cotan_laplacian.h"
+#include "specdeform/operators/laplacian.h"
 #include "specdeform/operators/mass_matrix.h"
 #include "specdeform/spectral/basis_cache.h"
 #include "specdeform/spectral/basis_store.h"
@@ -71,20 +71,24 @@ ManifoldHarmonicsOptions harmonics_options(const TriangleMesh& mesh, int k, cons
 void bind_spectral(py::module_& m) {
   m.def(
       "cotan_stiffness",
-      [](py::handle V, py::handle F) { return to_scipy(cotan_stiffness(to_mesh(V, F))); },
+      [](py::handle V, py::handle F) {
+        return to_scipy(stiffness_matrix(to_mesh(V, F), LaplacianType::Cotan));
+      },
       py::arg("V"), py::arg("F"),
       R"(The cotangent stiffness matrix K (n x n scipy.sparse.csc_matrix).
 
 Positive semi-definite, K 1 = 0, x^T K x the Dirichlet energy: K_ij = -(cot a + cot b) / 2 for
-an edge ij. libigl's cotmatrix is -K.)");
+an edge ij. libigl's cotmatrix is -K. On a mesh with zero-area faces, zero-length edges or caps,
+built on its mollified edge lengths, as every solver of the library builds it.)");
   m.def(
       "mass_matrix",
       [](py::handle V, py::handle F, const std::string& kind) {
-        return to_scipy(mass_matrix(to_mesh(V, F), mass_from_name(kind)));
+        return to_scipy(mass_matrix(to_mesh(V, F), mass_from_name(kind), LaplacianType::Cotan));
       },
       py::arg("V"), py::arg("F"), py::arg("kind") = "lumped",
       R"(The mass matrix M (n x n scipy.sparse.csc_matrix): "lumped" (diagonal, a third of the
-areas around each vertex) or "consistent" (linear finite elements).)");
+areas around each vertex) or "consistent" (linear finite elements); mollified as K is, so that
+every vertex has an area.)");
 
   py::class_<Harmonics>(m, "Harmonics",
                         R"(A manifold-harmonics basis: the owner of the arrays manifold_harmonics
@@ -224,7 +228,7 @@ reads, or writes when it does not exist: to compute a basis without a cache and 
         Eigen::MatrixXd C;
         {
           py::gil_scoped_release release;
-          C = harmonics_forward(b.H(), mass_matrix(mesh, b.mass), s.X);
+          C = harmonics_forward(b.H(), mass_matrix(mesh, b.mass, LaplacianType::Cotan), s.X);
         }
         return signal_array(std::move(C), s.vector);
       },
@@ -258,8 +262,9 @@ default V.)");
         Eigen::MatrixXd Y;
         {
           py::gil_scoped_release release;
-          Y = harmonics_inverse(b.H(), harmonics_forward(b.H(), mass_matrix(mesh, b.mass), s.X),
-                                k.value_or(-1));
+          Y = harmonics_inverse(
+              b.H(), harmonics_forward(b.H(), mass_matrix(mesh, b.mass, LaplacianType::Cotan), s.X),
+              k.value_or(-1));
         }
         return signal_array(std::move(Y), s.vector);
       },
@@ -278,7 +283,8 @@ shapes of the paper's Fig. 2 for X = V.)");
         Eigen::MatrixXd Y;
         {
           py::gil_scoped_release release;
-          Y = spectral_filter(b.H(), mass_matrix(mesh, b.mass), s.X, g, residual_gain);
+          Y = spectral_filter(b.H(), mass_matrix(mesh, b.mass, LaplacianType::Cotan), s.X, g,
+                              residual_gain);
         }
         return signal_array(std::move(Y), s.vector);
       },

@@ -6,7 +6,7 @@
 #include "bindings.h"
 #include "convert.h"
 #include "specdeform/exceptions.h"
-#include "specdeform/operators/cotan_laplacian.h"
+#include "specdeform/operators/laplacian.h"
 #include "specdeform/spectral/basis_cache.h"
 #include "specdeform/spectral/basis_store.h"
 
@@ -35,7 +35,8 @@ std::shared_ptr<const ManifoldHarmonics> copied_basis(py::handle evals, py::hand
   h->eigenvalues = to_vector(evals, h->basis.cols(), "evals");
   h->mass = mass;
   py::gil_scoped_release release;
-  const Eigen::SparseMatrix<double> M = mass_matrix(mesh, mass);
+  const LaplacianOperators L = laplacian_operators(mesh, mass, LaplacianType::Cotan);
+  const Eigen::SparseMatrix<double>& M = L.mass;
   h->max_orthogonality_error = orthonormality_error(M, h->basis);
   if (!(h->max_orthogonality_error <= kOrthonormalityTolerance)) {
     throw InputError(
@@ -43,7 +44,7 @@ std::shared_ptr<const ManifoldHarmonics> copied_basis(py::handle evals, py::hand
         " mass matrix (max |H^T M H - I| = " + std::to_string(h->max_orthogonality_error) +
         "); solve K h = lambda M h, e.g. scipy's eigsh(K, k, M, sigma=-0.01)");
   }
-  h->max_residual = eigen_residual(cotan_stiffness(mesh), M, h->basis, h->eigenvalues);
+  h->max_residual = eigen_residual(L.stiffness, M, h->basis, h->eigenvalues);
   return h;
 }
 

@@ -16,7 +16,6 @@
 #include "membrane_stiffness.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/vertex_clusters.h"
-#include "specdeform/operators/cotan_laplacian.h"
 #include "specdeform/operators/laplacian.h"
 #include "specdeform/operators/mass_matrix.h"
 
@@ -228,14 +227,10 @@ ArapSolver::ArapSolver(const TriangleMesh& mesh, const Vertices& base,
                                   : vertex_clusters(surface, options.clusters, moving);
       },
       [&] {
-        if (basis) {
-          LaplacianOperators L = laplacian_operators(mesh, MassType::Lumped, basis->laplacian);
-          K = std::move(L.stiffness);
-          mass = L.mass.diagonal();
-        } else {
-          K = cotan_stiffness(mesh);
-          mass = lumped_mass(mesh);
-        }
+        LaplacianOperators L = laplacian_operators(mesh, MassType::Lumped,
+                                                   basis ? basis->laplacian : LaplacianType::Cotan);
+        K = std::move(L.stiffness);
+        mass = L.mass.diagonal();
       });
   label_ = clusters.label;
   // Membrane and bending, as the linear energy's ks = 1 and kb = bending (unit-area scale).

@@ -25,7 +25,9 @@
 #include "mesh/vertex_rings.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/operators/cotan_laplacian.h"
+#include "specdeform/operators/laplacian.h"
 #include "specdeform/operators/mass_matrix.h"
+#include "specdeform/operators/mollification.h"
 
 namespace specdeform {
 
@@ -79,20 +81,22 @@ std::pair<double, double> edge_singular_values(const Vertices& V, const Faces& F
 }
 
 // Per face, the face whose base deformation gradient it takes: itself where its base triangle is
-// sound, else the nearest sound face through shared edges (breadth first from all sound faces
-// in order, each face's edges in the order of their sorted ends and the faces on an edge by
-// index), or -1 where its connected piece has none (its gradient is then the identity: the piece
-// keeps its shape). Only the sound faces beside an unsound one can give anything, so the walk
-// starts from those alone, and it finds the faces on an edge through the vertices' face lists.
+// sound and its own is no sliver, else the nearest sound face through shared edges (breadth first
+// from all sound faces in order, each face's edges in the order of their sorted ends and the faces
+// on an edge by index), or -1 where its connected piece has none (its gradient is then the
+// identity: the piece keeps its shape). Only the sound faces beside an unsound one can give
+// anything, so the walk starts from those alone, and it finds the faces on an edge through the
+// vertices' face lists.
 std::vector<int> transfer_donors(const TriangleMesh& detailed, const Vertices& base) {
   const int nf = detailed.num_faces();
   std::vector<int> donor(nf, -1);
   std::atomic<bool> all_sound = true;
   detail::split_in_two(nf, [&](Eigen::Index begin, Eigen::Index end) {
     for (Eigen::Index f = begin; f < end; ++f) {
-      const double size = edge_singular_values(detailed.V, detailed.F, f).first;
+      const auto [size, thin] = edge_singular_values(detailed.V, detailed.F, f);
       const auto [large, small] = edge_singular_values(base, detailed.F, f);
-      if (large > kMinRelativeSize * size && small > kMinAspect * large) {
+      if (thin > kMinAspect * size && large > kMinRelativeSize * size &&
+          small > kMinAspect * large) {
         donor[f] = static_cast<int>(f);
       } else {
         all_sound = false;
@@ -189,7 +193,11 @@ struct DetailReconstruction::Poisson {
   // P_f = Q_f B_f^-T. Where the base's triangle is degenerate, S_f = I and the corners get Q_f.
   // Gathered per vertex i, the right-hand side is linear in the deformed base s' but for the
   // unit normals n'_f:
-  //     b_i = constant_i + sum_j edges_ij s'_j + sum_f normal weight_if n'_f.
+  //     b_i = constant_i + sum_j edges_ij s'_j + sum_f normal weight_if n'_f,
+  // minus (G^T D G x)_i, the rest's own (in `constant`): the system is solved for the
+  // displacement x' - x, with the mollified stiffness (operators/laplacian.h) as its matrix, so
+  // that S_f = I gives back x on any mesh, and a vertex that only zero-area faces touch (a zero
+  // row of G^T D G) moves with the surface around it.
   // Everything here is numbered as the Poisson factor (`order`): a nested-dissection ordering
   // keeps neighbours close in memory, and the right-hand side is assembled where the solve
   // wants it.
@@ -318,14 +326,15 @@ DetailReconstruction::DetailReconstruction(const TriangleMesh& detailed, const V
       break;
     case DetailMethod::Frames: {
       // Each vertex's one-ring, except where the base's one-ring collapsed (as for the
-      // transfer's triangles): there the offset stays a plain displacement.
+      // transfer's triangles) or the mesh's own has no area (a vertex of zero-area faces alone:
+      // its ring is a line, which fits no rotation): there the offset stays a displacement.
       const int n = detailed.num_vertices();
       const detail::VertexRings rings = detail::vertex_rings(detailed);
       const Eigen::VectorXd area = lumped_mass(detailed);
       const Eigen::VectorXd base_area = lumped_mass(TriangleMesh{base, faces_});
       ring_start_.assign(n + 1, 0);
       for (int i = 0; i < n; ++i) {
-        if (base_area[i] > kMinRelativeSize * kMinRelativeSize * area[i]) {
+        if (area[i] > 0.0 && base_area[i] > kMinRelativeSize * kMinRelativeSize * area[i]) {
           ring_.insert(ring_.end(), rings.neighbour.begin() + rings.start[i],
                        rings.neighbour.begin() + rings.start[i + 1]);
         }
@@ -360,7 +369,12 @@ void DetailReconstruction::Poisson::build(const TriangleMesh& detailed, const Ve
   Poisson& p = *this;
   const int nf = detailed.num_faces();
   const int n = detailed.num_vertices();
-  p.system = std::make_unique<detail::AnchoredPoisson>(cotan_stiffness(detailed), solves);
+  // The rest's right-hand side G^T D G x: the mesh's own stiffness (degenerate faces carry no
+  // gradient), equal to the system's where the mesh needs no mollification.
+  const Sparse K = stiffness_matrix(detailed, LaplacianType::Cotan);
+  const Vertices rest_rhs =
+      (mollification(detailed) == 0.0 ? K : cotan_stiffness(detailed)) * detailed.V;
+  p.system = std::make_unique<detail::AnchoredPoisson>(K, solves);
   p.order = p.system->order();
   p.rank.resize(n);
   for (int k = 0; k < n; ++k) p.rank[p.order[k]] = k;
@@ -431,6 +445,7 @@ void DetailReconstruction::Poisson::build(const TriangleMesh& detailed, const Ve
   for (int k = 0; k < n; ++k) {
     p.detailed.row(k) = detailed.V.row(p.order[k]);
     s.row(k) = base.row(p.order[k]);
+    p.constant.row(k) -= rest_rhs.row(p.order[k]);
   }
   p.own.resize(nf);
   for (int g = 0; g < nf; ++g) p.own[g] = donors[face_order[g]] == face_order[g];
@@ -588,14 +603,16 @@ void DetailReconstruction::apply(const Vertices& s, const Eigen::MatrixX3d& anch
     add_product(p.normals, normals.data(), begin, end, x.data());
   });
   fold_zone_ = p.correct_folds(positions, normals, x);
-  for (int i = 0; i < p.coupling.outerSize(); ++i)
-    for (Sparse::InnerIterator it(p.coupling, i); it; ++it)
-      x.row(it.row()) -= it.value() * anchors.row(i);
-  for (size_t i = 0; i < p.anchors.size(); ++i) x.row(p.anchors[i]) = anchors.row(i);
+  for (int i = 0; i < p.coupling.outerSize(); ++i) {
+    const Eigen::RowVector3d moved = anchors.row(i) - p.detailed.row(p.anchors[i]);
+    for (Sparse::InnerIterator it(p.coupling, i); it; ++it) x.row(it.row()) -= it.value() * moved;
+  }
+  for (size_t i = 0; i < p.anchors.size(); ++i)
+    x.row(p.anchors[i]) = anchors.row(i) - p.detailed.row(p.anchors[i]);
   p.system->solve_in_place(x.data());
   out.resize(n, 3);
   detail::split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
-    for (Eigen::Index k = begin; k < end; ++k) out.row(p.order[k]) = x.row(k);
+    for (Eigen::Index k = begin; k < end; ++k) out.row(p.order[k]) = p.detailed.row(k) + x.row(k);
   });
 }
 

@@ -4,7 +4,7 @@
 #include <numeric>
 
 #include "mesh/sub_mesh.h"
-#include "specdeform/operators/mass_matrix.h"
+#include "specdeform/operators/laplacian.h"
 #include "spectral/piecewise.h"
 
 namespace specdeform::detail {
@@ -15,7 +15,7 @@ std::shared_ptr<const ManifoldHarmonics> moving_basis(const TriangleMesh& mesh,
                                                       const std::vector<int>& piece_of_mode,
                                                       const std::vector<char>& moving) {
   const size_t count = moving.size();
-  const Eigen::VectorXd area = lumped_mass(mesh);
+  const Eigen::VectorXd area = vertex_areas(mesh);
   std::vector<double> piece_area(count, 0.0);
   std::vector<int> piece_vertices(count, 0);
   for (int v = 0; v < mesh.num_vertices(); ++v) {

@@ -173,10 +173,8 @@ class SceneReader {
       : dir_(path.parent_path()),
         V_(mesh.file_vertices),
         kept_(mesh.vertex_to_file),
-        is_kept_(mesh.file_vertices.rows(), 0),
+        to_vertex_(mesh.file_to_vertex),
         read_file_(read_file) {
-    for (size_t v = 0; v < mesh.file_to_vertex.size(); ++v)
-      is_kept_[v] = mesh.file_to_vertex[v] >= 0;
     if (kept_.empty()) return;
     Eigen::Vector3d lo = V_.row(kept_[0]), hi = lo;
     for (const int v : kept_) {
@@ -327,18 +325,20 @@ class SceneReader {
     return checked_transform(m, t.where());
   }
 
-  // The centroid of the group's vertices that the mesh kept (of all of them if it kept none).
+  // The centroid of the mesh vertices the group names, each once: the file's copies of a welded
+  // vertex (glTF seams, PLY splits, STL corners) and a vertex listed twice count once, so that
+  // every exporter's file of a scene turns about the same point. Of the file vertices named, each
+  // once, where the mesh kept none of them.
   Eigen::Vector3d centroid(const std::vector<int>& vertices) const {
-    const bool any =
-        std::any_of(vertices.begin(), vertices.end(), [&](int v) { return is_kept_[v]; });
+    std::vector<int> points;
+    for (const int v : vertices)
+      if (to_vertex_[v] >= 0) points.push_back(kept_[to_vertex_[v]]);
+    if (points.empty()) points = vertices;
+    std::sort(points.begin(), points.end());
+    points.erase(std::unique(points.begin(), points.end()), points.end());
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    int count = 0;
-    for (const int v : vertices) {
-      if (any && !is_kept_[v]) continue;
-      sum += V_.row(v).transpose();
-      ++count;
-    }
-    return sum / std::max(count, 1);
+    for (const int v : points) sum += V_.row(v).transpose();
+    return sum / std::max<double>(static_cast<double>(points.size()), 1.0);
   }
 
   void read_settings(const Field& s, Scene& scene) const {
@@ -371,8 +371,8 @@ class SceneReader {
 
   std::filesystem::path dir_;
   const Vertices& V_;
-  const std::vector<int>& kept_;
-  std::vector<char> is_kept_;
+  const std::vector<int>& kept_;       // mesh vertex -> its first file vertex
+  const std::vector<int>& to_vertex_;  // file vertex -> mesh vertex (-1: dropped)
   const SceneFileReader& read_file_;
   double diagonal_ = 0.0;
 };

@@ -6,8 +6,7 @@
 #include "specdeform/deform/selection.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/mesh_info.h"
-#include "specdeform/operators/cotan_laplacian.h"
-#include "specdeform/operators/mass_matrix.h"
+#include "specdeform/operators/laplacian.h"
 
 namespace specdeform {
 
@@ -17,12 +16,11 @@ struct SpatialSolver::Factor {
 
 SpatialSolver::SpatialSolver(const TriangleMesh& mesh, const DeformOptions& options)
     : options_(options), factor_(std::make_unique<Factor>()) {
-  const Eigen::SparseMatrix<double> K = cotan_stiffness(mesh);
-  const Eigen::VectorXd mass = lumped_mass(mesh);
+  const LaplacianOperators L = laplacian_operators(mesh, MassType::Lumped, LaplacianType::Cotan);
+  const Eigen::SparseMatrix<double>& K = L.stiffness;
+  const Eigen::VectorXd mass = L.mass.diagonal();
+  check_operators(K, L.mass, "spatial solver");
   const double area = mass.sum();
-  if ((mass.array() <= 0.0).any()) {
-    throw InputError("spatial solver: some vertices have zero area (only degenerate faces)");
-  }
   int pieces = 0;
   const Eigen::VectorXi components = vertex_components(mesh, &pieces);
   vertex_area_ = piece_area_fractions(mass, components, pieces);

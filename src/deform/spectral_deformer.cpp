@@ -97,7 +97,8 @@ SpectralDeformer::SpectralDeformer(TriangleMesh mesh,
     piece_of_mode_ = num_components_ > 1 ? piece_of_columns(basis_->basis, components_)
                                          : std::vector<int>(basis_->basis.cols(), 0);
     const Eigen::MatrixXd& H = basis_->basis;
-    base_ = harmonics_inverse(H, harmonics_forward(H, mass_matrix(mesh_, basis_->mass), mesh_.V));
+    base_ = harmonics_inverse(
+        H, harmonics_forward(H, mass_matrix(mesh_, basis_->mass, basis_->laplacian), mesh_.V));
   } else {
     base_ = mesh_.V;
   }
@@ -136,7 +137,7 @@ void SpectralDeformer::build_solvers(std::shared_ptr<const ManifoldHarmonics> ba
     reduced_ = std::make_unique<ReducedSolver>(
         solve_basis_,
         arap_ ? arap_->reduced_hessian() : linear_hessian(mesh_, *solve_basis_, options_),
-        piece_area_fractions(lumped_mass(mesh_), components_, num_components_), options_);
+        piece_area_fractions(vertex_areas(mesh_), components_, num_components_), options_);
     factored_ = solve_basis_->factored.smaller_than_dense(options_.float32_basis ? 4 : 8);
     if (options_.float32_basis && !factored_) basis32_ = solve_basis_->basis.cast<float>();
   } else {
@@ -358,6 +359,18 @@ void SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms, Ver
   base_miss_.max /= diagonal_;
   base_miss_.rms =
       std::sqrt(base_miss_.rms / std::max<size_t>(constrained_.first_free, 1)) / diagonal_;
+  detail_targets_ = options_.detail == DetailMethod::None
+                        ? base_targets
+                        : constraint_targets(constrained_, mesh_.V, transforms);
+  const Vertices& rest = options_.detail == DetailMethod::None ? base_ : mesh_.V;
+  if (deformed_base_ == base_ && detail_targets_ == rest(constrained, Eigen::all)) {
+    // Nothing moved: the result of every detail method is the rest itself, to the bit (a
+    // Poisson solve or a fitted rotation would give it to rounding only).
+    result = rest;
+    frame_.detail = clock.lap();
+    frame_.total = total.lap();
+    return;
+  }
   double deferred = 0.0;
   if (options_.single_solve) {  // the solvers' memory back before the details take theirs
     clock.lap();
@@ -372,12 +385,8 @@ void SpectralDeformer::solve(const std::vector<Eigen::Affine3d>& transforms, Ver
     details_->set_anchors(constrained_.vertices);
     deferred = setup_.detail_factorization = clock.lap();
   }
-  detail_targets_ = options_.detail == DetailMethod::None
-                        ? base_targets
-                        : constraint_targets(constrained_, mesh_.V, transforms);
   details_->apply(deformed_base_, detail_targets_, result);
   if (follow_) {
-    const Vertices& rest = options_.detail == DetailMethod::None ? base_ : mesh_.V;
     const std::vector<Eigen::Affine3d> motions = follow_->motions(rest, result);
     follow_->apply(motions, base_, deformed_base_);
     follow_->apply(motions, rest, result);

@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "specdeform/exceptions.h"
+#include "specdeform/operators/mollification.h"
 
 namespace specdeform {
 
@@ -28,14 +29,8 @@ int prev(int h) {
   return h % 3 == 0 ? h + 2 : h - 1;
 }
 
-// Twice the area of the triangle with sides a, b, c (Kahan's formula, accurate for slivers); 0
-// where rounding breaks the triangle inequality.
 double double_area(double a, double b, double c) {
-  if (a < b) std::swap(a, b);
-  if (a < c) std::swap(a, c);
-  if (b < c) std::swap(b, c);
-  const double p = (a + (b + c)) * (c - (a - b)) * (c + (a - b)) * (a + (b - c));
-  return p > 0.0 ? 0.5 * std::sqrt(p) : 0.0;
+  return double_area_from_lengths(a, b, c);
 }
 
 // The cotangent of the angle opposite to side a.
@@ -160,8 +155,10 @@ void sort_about_edge(const TriangleMesh& mesh, int u, int v, std::vector<int>& h
   for (size_t r = 0; r < angles.size(); ++r) halfedges[r] = angles[r].second;
 }
 
-// The mesh's triangles (or its tufted cover's) with Euclidean edge lengths, glued.
-Halfedges initial_triangulation(const TriangleMesh& mesh, const EdgeGroups& groups, bool cover) {
+// The mesh's triangles (or its tufted cover's) with their Euclidean edge lengths plus eps (the
+// mollification), glued.
+Halfedges initial_triangulation(const TriangleMesh& mesh, const EdgeGroups& groups, bool cover,
+                                double eps) {
   const int faces = mesh.num_faces(), sheets = cover ? 2 : 1;
   Halfedges t;
   t.vertex.resize(3 * size_t(faces) * sheets);
@@ -173,7 +170,7 @@ Halfedges initial_triangulation(const TriangleMesh& mesh, const EdgeGroups& grou
   for (int h = 0; h < 3 * faces; ++h) {
     const int u = mesh.F(h / 3, h % 3), v = mesh.F(h / 3, (h % 3 + 1) % 3);
     t.vertex[h] = u;
-    t.length[h] = (mesh.V.row(v) - mesh.V.row(u)).norm();
+    t.length[h] = (mesh.V.row(v) - mesh.V.row(u)).norm() + eps;
     if (cover) {
       t.vertex[reversed(h)] = v;
       t.length[reversed(h)] = t.length[h];
@@ -260,7 +257,7 @@ IntrinsicTriangulation intrinsic_delaunay(const TriangleMesh& mesh) {
   const EdgeGroups groups = group_edges(mesh);
   out.tufted = needs_cover(mesh, groups);
   out.sheet_weight = out.tufted ? 0.5 : 1.0;
-  Halfedges t = initial_triangulation(mesh, groups, out.tufted);
+  Halfedges t = initial_triangulation(mesh, groups, out.tufted, mollification(mesh));
   out.flips = flip_to_delaunay(t);
   const int triangles = static_cast<int>(t.vertex.size() / 3);
   out.F.resize(triangles, 3);
@@ -271,6 +268,15 @@ IntrinsicTriangulation intrinsic_delaunay(const TriangleMesh& mesh) {
     out.length(h / 3, h % 3) = t.length[h];
     out.twin(h / 3, h % 3) = t.twin[h];
   }
+  return out;
+}
+
+IntrinsicTriangulation mollified_triangulation(const TriangleMesh& mesh) {
+  IntrinsicTriangulation out;
+  out.num_vertices = mesh.num_vertices();
+  out.F = mesh.F;
+  out.length = mollified_lengths(mesh, mollification(mesh));
+  out.twin.setConstant(mesh.num_faces(), 3, -1);
   return out;
 }
 

@@ -60,6 +60,7 @@ void ManifoldHarmonicsPolicy::validate() const {
   require(reorder_from >= 0, "reorder_from must be >= 0");
   require(piece_min_modes >= 1 && piece_modes_limit >= 1,
           "piece_min_modes and piece_modes_limit must be >= 1");
+  require(piece_basis_bytes > 0.0, "piece_basis_bytes must be > 0");
 }
 
 void ManifoldHarmonicsOptions::validate() const {
@@ -79,8 +80,16 @@ double eigen_residual(const Sparse& K, const Sparse& M, const Mat& H, const Vec&
 
 std::string residual_summary(const ManifoldHarmonics& h) {
   std::ostringstream s;
-  s << std::setprecision(2) << "residual " << h.max_residual << " (threshold " << h.threshold
-    << ", rounding floor " << h.rounding_floor << ")";
+  s << std::setprecision(2);
+  const ManifoldHarmonics::Pair& w = h.worst_pair;
+  if (w.index < 0) {
+    s << "residual " << h.max_residual << " (threshold " << h.threshold << ", rounding floor "
+      << h.rounding_floor << ")";
+    return s.str();
+  }
+  s << "pair " << w.index + 1 << " of " << h.basis.cols() << ": residual " << w.residual
+    << " (its threshold " << w.threshold << ", rounding floor " << w.floor << ")";
+  if (w.residual < h.max_residual) s << ", the largest residual " << h.max_residual;
   return s.str();
 }
 
@@ -156,12 +165,8 @@ ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Spa
     throw InputError("manifold harmonics: the number of modes must be in [1, " + std::to_string(n) +
                      "] for this mesh, got " + std::to_string(m));
   }
+  check_operators(K, M, "manifold harmonics");
   const Vec row_sums = M * Vec::Ones(n);
-  const int massless = static_cast<int>((row_sums.array() <= 0.0).count());
-  if (massless > 0) {
-    throw InputError("manifold harmonics: " + std::to_string(massless) +
-                     " vertices have zero area (only degenerate faces touch them)");
-  }
   const double area = row_sums.sum();
   const Sparse M_unit = M / area;
   const ManifoldHarmonicsPolicy& p = o.policy;
@@ -215,7 +220,14 @@ ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Spa
   out.residuals = errors.residual;
   out.max_residual = errors.residual.maxCoeff();
   out.rounding_floor = errors.floor.maxCoeff();
-  out.threshold = errors.thresholds(o.tolerance, p.floor_factor).maxCoeff();
+  const Vec thresholds = errors.thresholds(o.tolerance, p.floor_factor);
+  out.threshold = thresholds.maxCoeff();
+  if (columns > 0) {
+    Eigen::Index worst;
+    errors.residual.cwiseQuotient(thresholds).maxCoeff(&worst);
+    out.worst_pair = {static_cast<int>(worst), errors.residual[worst], thresholds[worst],
+                      errors.floor[worst]};
+  }
   out.max_orthogonality_error = orthonormality_error(M, out.basis);
   // An approximate basis is not meant to meet the tolerance: its status is the coarse solve's.
   if (!multilevel && !errors.within(o.tolerance, p.floor_factor)) {

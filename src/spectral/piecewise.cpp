@@ -39,7 +39,10 @@ std::vector<int> piece_modes(const std::vector<double>& area, const std::vector<
         std::min(vertices[i], std::max(share, std::min(policy.piece_min_modes, vertices[i])));
     sum += modes[i];
   }
-  const long long limit = static_cast<long long>(policy.piece_modes_limit) * m;
+  const double rows = std::accumulate(vertices.begin(), vertices.end(), 0.0);
+  const long long limit = std::max<long long>(
+      m, std::min(static_cast<long long>(policy.piece_modes_limit) * m,
+                  static_cast<long long>(policy.piece_basis_bytes / (8.0 * std::max(rows, 1.0)))));
   std::vector<size_t> by_area(count);
   std::iota(by_area.begin(), by_area.end(), size_t{0});
   std::stable_sort(by_area.begin(), by_area.end(),

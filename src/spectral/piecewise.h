@@ -17,7 +17,8 @@ namespace specdeform::detail {
 
 // The modes of each piece, for m asked in all: its share of the area, m a_i / A rounded, and at
 // least min(policy.piece_min_modes, its vertices), at most its vertices. When that comes to more
-// than policy.piece_modes_limit * m in all, the pieces of least area keep their constant mode
+// than policy.piece_modes_limit * m in all, or more columns than policy.piece_basis_bytes hold
+// (but never fewer than m), the pieces of least area keep their constant mode
 // only, smallest first, until it fits; where the constants alone exceed it (thousands of specks
 // of a scan), the smallest pieces get none (their low-pass is the origin; as free pieces they
 // follow or stay all the same), so that the basis stays within the limit.

@@ -256,6 +256,24 @@ TEST_F(SceneFiles, VerticesTheReaderDropped) {
             1e-12);
 }
 
+// A vertex the file has several copies of (a glTF seam, a PLY split) counts once in a group's
+// centroid: file vertices 1, 2 and 3 are one mesh vertex at (0, 0, 0), 4 is (3, 0, 0), so a
+// group of all four turns about (1.5, 0, 0), as the welded file's group would, not about
+// (0.75, 0, 0); a file vertex listed twice counts once too.
+TEST_F(SceneFiles, CentroidCountsWeldedCopiesOnce) {
+  MeshReadInfo info;
+  info.file_vertices.resize(5, 3);
+  info.file_vertices << 9, 9, 9, 0, 0, 0, 0, 0, 0, 0, 0, 0, 3, 0, 0;
+  info.vertex_to_file = {0, 1, 4};
+  info.file_to_vertex = {0, 1, 1, 1, 2};
+  const Scene s = read_scene(write("c.json", R"({
+    "handles": [{"vertices": [1, 2, 3, 4], "transform": {"scale": 2}},
+                {"vertices": [4, 1, 1], "transform": {"scale": 2}}]})"),
+                             info);
+  for (const Eigen::Affine3d& T : s.transforms)
+    EXPECT_LT((T * Eigen::Vector3d(1.5, 0, 0) - Eigen::Vector3d(1.5, 0, 0)).norm(), 1e-12);
+}
+
 TEST_F(SceneFiles, ParsedFromMemoryWithItsFiles) {
   const Vertices V = Eigen::MatrixX3d::Random(3, 3);
   MeshReadInfo info;

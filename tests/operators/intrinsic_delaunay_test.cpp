@@ -9,6 +9,7 @@
 #include "specdeform/mesh/generate.h"
 #include "specdeform/mesh/io.h"
 #include "specdeform/operators/cotan_laplacian.h"
+#include "specdeform/operators/mollification.h"
 #include "support/corpus.h"
 
 namespace specdeform {
@@ -168,8 +169,9 @@ TEST(IntrinsicDelaunay, TuftedCoverGluesNeighbouringPages) {
 
 TEST(IntrinsicDelaunay, FlatCapIsFlippedAway) {
   // A vertex q exactly on the diagonal a-b of a cell: the triangle (a, b, q) is flat (its angle
-  // at q is pi) and carries nothing in the cotangent Laplacian; intrinsically the diagonal flips
-  // to q-d, and the result is that of the cell split into four.
+  // at q is pi); mollified, it is a sliver whose angle at q is just below pi, intrinsically the
+  // diagonal flips to q-d, and the result is that of the cell split into four, to the
+  // mollification's margin (the sliver's area, of the order of its length^1.5 margin^0.5).
   const TriangleMesh grid = test::skewed_grid(4, 4, 1.0, 1.0, 0, 0.1);
   const int f = 10, a = grid.F(f, 0), b = grid.F(f, 1), c = grid.F(f, 2);
   int g = -1, d = -1;  // the triangle (b, a, d) across a-b
@@ -193,10 +195,10 @@ TEST(IntrinsicDelaunay, FlatCapIsFlippedAway) {
   EXPECT_GE(tri.flips, 1);
   expect_valid_delaunay(tri, "capped");
   const IntrinsicTriangulation reference = intrinsic_delaunay(split);
-  EXPECT_LT(relative_difference(stiffness_matrix(tri), stiffness_matrix(reference)), 1e-12);
+  EXPECT_LT(relative_difference(stiffness_matrix(tri), stiffness_matrix(reference)), 1e-3);
   EXPECT_LT(relative_difference(mass_matrix(tri, MassType::Lumped),
                                 mass_matrix(reference, MassType::Lumped)),
-            1e-12);
+            1e-3);
 }
 
 TEST(IntrinsicDelaunay, RejectsFacesOutsideTheVertices) {
@@ -215,8 +217,10 @@ TEST(IntrinsicDelaunay, SharedMeshes) {
     const IntrinsicTriangulation tri = intrinsic_delaunay(mesh);
     const std::string name = entry.path().filename().string();
     expect_valid_delaunay(tri, name);
+    // A mesh with caps (decimated-max.obj) is mollified: its area grows by 2e-5.
+    const double tolerance = mollification(mesh) > 0.0 ? 1e-4 : 1e-10;
     EXPECT_NEAR(mass_matrix(tri, MassType::Lumped).sum(), surface_area(mesh),
-                1e-10 * surface_area(mesh))
+                tolerance * surface_area(mesh))
         << name;
   }
 }

@@ -77,6 +77,121 @@ std::vector<CorpusMesh> make_corpus() {
 
 }  // namespace
 
+namespace {
+
+// A vertex q on the first edge a-b of every `every`-th triangle (a, b, c) of `mesh`, with the
+// zero-area face (a, b, q): in turn the triangle split at q (a T-junction), or kept whole (q is
+// then touched by the zero-area face alone: a vertex of zero area).
+void add_t_junctions(MessyMesh& m, int every) {
+  TriangleMesh& mesh = m.mesh;
+  const int faces = mesh.num_faces();
+  for (int f = 0; f < faces; f += every) {
+    const int a = mesh.F(f, 0), b = mesh.F(f, 1), c = mesh.F(f, 2);
+    const int q = mesh.num_vertices();
+    mesh.V.conservativeResize(q + 1, 3);
+    mesh.V.row(q) = 0.5 * (mesh.V.row(a) + mesh.V.row(b));
+    const bool split = m.t_junctions.size() % 2 == 0;
+    mesh.F.conservativeResize(mesh.num_faces() + (split ? 2 : 1), 3);
+    if (split) {
+      mesh.F.row(f) << a, q, c;
+      mesh.F.row(mesh.num_faces() - 2) << q, b, c;
+    }
+    mesh.F.row(mesh.num_faces() - 1) << a, b, q;  // zero area
+    m.t_junctions.push_back({a, q, b});
+  }
+}
+
+std::vector<MessyMesh> make_messy() {
+  std::vector<MessyMesh> out;
+  {
+    MessyMesh m{"t_junctions_and_dust", make_bumpy_plane({1.0, 16, 2, 0.05}), {}};
+    add_t_junctions(m, 7);
+    TriangleMesh dust;
+    dust.V.resize(5, 3);
+    for (int k = 0; k < 5; ++k) dust.V.row(k) << 1.2 + 0.05 * k, 0.5, 0.1;
+    dust.F.resize(3, 3);
+    dust.F << 0, 1, 2, 1, 2, 3, 2, 3, 4;
+    m.mesh = concatenate(m.mesh, dust);
+    out.push_back(std::move(m));
+  }
+  {
+    TriangleMesh sphere = make_icosphere(2);
+    for (int f = 0; f < sphere.num_faces(); ++f)
+      if (sphere.V.row(sphere.F(f, 0)).z() > 0.0) std::swap(sphere.F(f, 1), sphere.F(f, 2));
+    const int fin = sphere.num_vertices();
+    sphere.V.conservativeResize(fin + 1, 3);
+    sphere.V.row(fin) = 1.6 * (0.5 * (sphere.V.row(sphere.F(0, 0)) + sphere.V.row(sphere.F(0, 1))));
+    sphere.F.conservativeResize(sphere.num_faces() + 1, 3);
+    sphere.F.row(sphere.num_faces() - 1) << sphere.F(0, 0), sphere.F(0, 1), fin;
+    // A second sphere touching the first at its lowest vertex: they share it (a pinch).
+    TriangleMesh other = make_icosphere(1, 0.5);
+    Eigen::Index low, top;
+    sphere.V.col(2).minCoeff(&low);
+    other.V.col(2).maxCoeff(&top);
+    other.V.rowwise() += sphere.V.row(low) - other.V.row(top);
+    TriangleMesh joined = concatenate(sphere, other);
+    const int shift = sphere.num_vertices(), merged = shift + static_cast<int>(top);
+    for (int f = sphere.num_faces(); f < joined.num_faces(); ++f) {
+      for (int k = 0; k < 3; ++k) {
+        int& v = joined.F(f, k);
+        v = v == merged ? static_cast<int>(low) : v > merged ? v - 1 : v;
+      }
+    }
+    joined.V.block(merged, 0, joined.V.rows() - merged - 1, 3) =
+        joined.V.bottomRows(joined.V.rows() - merged - 1).eval();
+    joined.V.conservativeResize(joined.V.rows() - 1, 3);
+    MessyMesh m{"misoriented_fin_pinch", joined, {}};
+    add_t_junctions(m, 29);
+    out.push_back(std::move(m));
+  }
+  {
+    BumpyBarOptions bar;
+    bar.cells_per_unit = 6;
+    MessyMesh m{"confetti", make_bumpy_bar(bar), {}};
+    add_t_junctions(m, 31);
+    for (int k = 0; k < 60; ++k) {
+      TriangleMesh speck;
+      const bool tetrahedron = k % 2 == 0;
+      speck.V.resize(tetrahedron ? 4 : 3, 3);
+      speck.V << 0, 0, 0, 1, 0, 0, 0, 1, 0;
+      if (tetrahedron) speck.V.row(3) << 0, 0, 1;
+      speck.V *= 0.01 * (1 + k % 5);
+      speck.V.rowwise() += Eigen::RowVector3d(0.07 * k, 0.6 + 0.1 * (k % 3), 0.05 * (k % 7));
+      speck.F.resize(tetrahedron ? 4 : 1, 3);
+      if (tetrahedron) {
+        speck.F << 0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2;
+      } else {
+        speck.F << 0, 1, 2;
+      }
+      m.mesh = concatenate(m.mesh, speck);
+    }
+    out.push_back(std::move(m));
+  }
+  {
+    // Two vertices at one place: the grid's corner copied, the copy used by the corner's face.
+    TriangleMesh grid = make_bumpy_plane({1.0, 10, 1, 0.03});
+    const int copy = grid.num_vertices();
+    grid.V.conservativeResize(copy + 1, 3);
+    grid.V.row(copy) = grid.V.row(grid.F(0, 0));
+    grid.F.conservativeResize(grid.num_faces() + 1, 3);
+    grid.F.row(grid.num_faces() - 1) << grid.F(0, 0), grid.F(0, 1), copy;
+    MessyMesh m{"caps_and_needles", grid, {}};
+    add_t_junctions(m, 3);
+    // Each T-junction's vertex nudged off its edge by a hair: a cap, not a zero-area face.
+    for (const auto& [a, q, b] : m.t_junctions)
+      m.mesh.V(q, 2) += 1e-9 * (m.mesh.V.row(a) - m.mesh.V.row(b)).norm();
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+}  // namespace
+
+const std::vector<MessyMesh>& messy() {
+  static const std::vector<MessyMesh> m = make_messy();
+  return m;
+}
+
 const std::vector<CorpusMesh>& corpus() {
   static const std::vector<CorpusMesh> c = make_corpus();
   return c;

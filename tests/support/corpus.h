@@ -3,6 +3,7 @@
 // suite needs no data files; real meshes from ../shared are added where that folder exists.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -25,6 +26,24 @@ struct CorpusMesh {
 
 // The generated corpus (each mesh has at most a few thousand vertices).
 const std::vector<CorpusMesh>& corpus();
+
+// Meshes as tools write them (issue 52), each with vertices on an edge, touched by a zero-area
+// face (T-junctions, and vertices of zero area that the zero-area face alone touches), and the
+// edge's ends:
+//  - t_junctions_and_dust: a bumpy plane whose cells have vertices on their diagonals, each
+//    touched by one zero-area face, and a piece of zero-area faces alone (collinear points);
+//  - misoriented_fin_pinch: a sphere with half its triangles wound the other way, a fin (an
+//    edge of three triangles) and a second sphere touching it at one vertex;
+//  - confetti: a bumpy bar among 60 specks of one triangle or four (thousands of pieces in
+//    game scenes);
+//  - caps_and_needles: a grid cut into caps (angles a hair below pi) with zero-length edges
+//    (two vertices at one place, both used).
+struct MessyMesh {
+  std::string name;
+  TriangleMesh mesh;
+  std::vector<std::array<int, 3>> t_junctions;  // (a, q, b): q on the edge a-b
+};
+const std::vector<MessyMesh>& messy();
 
 // ../shared beside the checkout, or an empty path if it is absent.
 std::filesystem::path shared_dir();

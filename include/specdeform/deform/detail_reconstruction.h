@@ -14,7 +14,9 @@
 //                  gradient S_f = [c'-a', b'-a', n'] [c-a, b-a, n]^-1 of s -> s' (unit normals),
 //                  applied to the gradients of x; then the Poisson system K x' = G^T D [S grad x]
 //                  on the detailed mesh, with the anchors (the constrained vertices) at their
-//                  exact targets. K is analysed once, factored (CHOLMOD LDL^T) for the first
+//                  exact targets, solved for x' - x with K the mesh's mollified stiffness
+//                  (operators/laplacian.h: a vertex of zero-area faces alone follows its
+//                  neighbours). K is analysed once, factored (CHOLMOD LDL^T) for the first
 //                  anchor set and then updated by the anchors that change (row additions and
 //                  deletions); a frame is O(f) plus one back-substitution with 3 columns, both
 //                  on two threads. In the background (for interactive front ends), a thread
@@ -26,7 +28,9 @@
 // Where the low-pass collapsed the base (a small piece keeps only its constant mode among the
 // first m and its base is a point; thin tips and slivers nearly so), a base triangle's or
 // one-ring's frame is rounding noise. Such a triangle (its base edges below 1e-3 of the detailed
-// ones, or its base a sliver of aspect below 1e-3) takes the deformation gradient of the
+// ones, or its base a sliver of aspect below 1e-3), and a sliver of the mesh itself (a cap or a
+// needle of aspect below 1e-3, whose base is one too: its frame's inverse is rounding noise
+// magnified, 4e5 times the mesh's size on a scan's cap), takes the deformation gradient of the
 // nearest sound triangle of its piece, or the identity where its piece has none (the piece
 // keeps its shape and follows its anchors); such a vertex keeps its offset as a displacement
 // (Frames).

@@ -28,10 +28,13 @@
 // edges flip; we keep boundary edges on either path, so that both give Fisher et al.'s
 // triangulation of a manifold mesh with boundary.)
 //
-// Triangles that are degenerate by is_degenerate_triangle's rule (twice the area at most 1e-12
-// times the longest edge squared), measured on the lengths, take part in the flips as far as
-// their angles are defined (a flat triangle's angle of pi flips its long edge) and carry no
-// weight and no mass.
+// The lengths are mollified first (mollification.h): every triangle then meets its triangle
+// inequalities by a margin, so that every angle is defined and no triangle is degenerate. Each
+// flip then strictly lowers the Dirichlet energy of the piecewise-linear functions (Bobenko &
+// Springborn, section 4), the triangulations of a surface with these vertices are finitely many,
+// and the flips end (the test's margin of 1e-10 keeps rounding from flipping an edge back and
+// forth; the cap of 100 flips per edge is a guard). Before mollification, zero-area triangles
+// (angles of 0 and pi) flipped on and on: over 2e8 flips on a 332k-vertex room scene.
 #pragma once
 
 #include <Eigen/Core>
@@ -59,6 +62,10 @@ struct IntrinsicTriangulation {
 // Throws SolverError if the flips do not end within 100 flips per edge (rounding on a
 // pathological mesh), InputError for a face with a vertex index out of range.
 IntrinsicTriangulation intrinsic_delaunay(const TriangleMesh& mesh);
+
+// The mesh's own triangles on their mollified lengths, unflipped and unglued (twin -1): the
+// cotan Laplacian of a mesh that needs mollification (laplacian.h).
+IntrinsicTriangulation mollified_triangulation(const TriangleMesh& mesh);
 
 // The cotangent weight of the edge of corner c of triangle t: (cot a + cot b) / 2 with a, b the
 // angles opposite to it (one on the boundary; a degenerate triangle's counts 0), times

@@ -109,6 +109,11 @@ struct ManifoldHarmonicsPolicy {
   // (tests/spectral/piecewise_test.cpp).
   int piece_min_modes = 16;
   int piece_modes_limit = 16;
+  // ... and at most as many columns as this many bytes of dense basis hold (n rows of doubles),
+  // but never fewer than m: 1,899 teapots (3.96M vertices, 5,698 pieces) at m = 100 asked for
+  // 1,600 columns, 51 GB; within 4 GB they get 126 (the largest pieces their modes, the smallest
+  // none: they follow the surface as free pieces).
+  double piece_basis_bytes = 4e9;
 
   void validate() const;  // throws InputError
 };
@@ -165,11 +170,18 @@ struct ManifoldHarmonics {
   // Converged: every pair's residual is within its threshold, max(tolerance,
   // floor_factor * its rounding floor); `threshold` is the largest threshold applied.
   SolveStatus status = SolveStatus::Converged;
-  Eigen::VectorXd residuals;             // per pair, as `tolerance` defines it
-  double max_residual = 0.0;             // their max
-  double rounding_floor = 0.0;           // max over pairs of the rounding error of K h - l M h
-                                         // (0 for an approximate basis: not computed)
-  double threshold = 0.0;                // max over pairs of the threshold applied
+  Eigen::VectorXd residuals;    // per pair, as `tolerance` defines it
+  double max_residual = 0.0;    // their max
+  double rounding_floor = 0.0;  // max over pairs of the rounding error of K h - l M h
+                                // (0 for an approximate basis: not computed)
+  double threshold = 0.0;       // max over pairs of the threshold applied
+  // The pair furthest over its own threshold (or, converged, nearest to it): what a message
+  // about the result names, its residual, threshold and floor agreeing with each other. Index
+  // -1 where not known (a basis read from a cache file).
+  struct Pair {
+    int index = -1;
+    double residual = 0.0, threshold = 0.0, floor = 0.0;
+  } worst_pair;
   double max_orthogonality_error = 0.0;  // max |H^T M H - I|
   bool cluster_truncated = false;        // lambda_m is (nearly) equal to lambda_{m+1}
   // Multilevel: the basis spans a coarse space of this many functions and is not made of
@@ -207,7 +219,9 @@ ManifoldHarmonics compute_manifold_harmonics(const Eigen::SparseMatrix<double>& 
 double eigen_residual(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M,
                       const Eigen::MatrixXd& H, const Eigen::VectorXd& lambda);
 
-// "residual 3.2e-08 (threshold 1e-08, rounding floor 1.1e-12)": for messages about a result.
+// "residual 3.2e-08 (threshold 1e-08, rounding floor 1.1e-12)": for messages about a result,
+// the figures of its worst pair ("pair 41 of 100: residual ..., the largest residual 5e-08"
+// where that pair's residual is not the largest).
 std::string residual_summary(const ManifoldHarmonics& h);
 
 // max |H^T M H - I|.

@@ -44,8 +44,8 @@ JoinedLines join_continued_lines(std::string_view data) {
 bool joins_a_vertex_line(const JoinedLines& joined) {
   for (const size_t at : joined.at) {
     const size_t newline = joined.text.rfind('\n', at);
-    std::string_view line = std::string_view(joined.text).substr(
-        newline == std::string::npos ? 0 : newline + 1);
+    std::string_view line =
+        std::string_view(joined.text).substr(newline == std::string::npos ? 0 : newline + 1);
     while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
     if (line.starts_with("v ") || line.starts_with("v\t") || line.starts_with("vn")) return true;
   }
@@ -285,7 +285,8 @@ void keep_record(ObjRecord&& r, std::string_view data, KeptRecord& keep) {
     a.polygon_material = std::move(r.material);
     for (int& m : a.polygon_material) m = std::max(m, -1);  // before any usemtl: none
   }
-  keep.layout.format = ObjLayout{std::move(r.v), std::move(r.vn), std::move(r.mtllib), r.groups, {}};
+  keep.layout.format =
+      ObjLayout{std::move(r.v), std::move(r.vn), std::move(r.mtllib), r.groups, {}};
 }
 
 }  // namespace
