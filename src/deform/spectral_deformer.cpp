@@ -211,7 +211,12 @@ Eigen::MatrixX3d SpectralDeformer::solve_coefficients(
   // ARAP starts from the handles' rotations spread over the surface, or from the last frame
   // when asked to.
   const Eigen::Index size = reduced_ ? solve_basis_->basis.cols() : mesh_.num_vertices();
-  const bool warm = options_.arap.warm_start && state_.x.rows() == size;
+  // With every transform the identity, the cold start is the rest itself, where ARAP stops at
+  // once; a warm start from the last drag would stop near the rest, not on it.
+  const bool at_rest = std::all_of(
+      transforms.begin(), transforms.end(),
+      [](const Eigen::Affine3d& t) { return t.matrix() == Eigen::Matrix4d::Identity(); });
+  const bool warm = options_.arap.warm_start && state_.x.rows() == size && !at_rest;
   arap_report_ = ArapReport{};
   arap_report_.converged = true;
   if (reduced_) {

@@ -65,14 +65,7 @@ TEST(MessyMeshes, TheRestIsAnExactFixedPointAndABendReachesItsHandles) {
       o.laplacian = laplacian;
       const auto basis =
           std::make_shared<const ManifoldHarmonics>(compute_manifold_harmonics(mesh, o));
-      // The cotan Laplacian of caps_and_needles (caps, and a zero-length edge between two
-      // vertices that every file reader welds into one) stalls the eigensolver at residuals of
-      // 1e-5, which deform refuses naming the pair (basis_store.h); written to an OBJ and read
-      // back (welded) it converges (7e-9 at m = 40), as does its intrinsic Delaunay Laplacian.
-      const bool stalls = laplacian == LaplacianType::Cotan && m.name == "caps_and_needles";
-      EXPECT_TRUE(basis->status == SolveStatus::Converged ||
-                  (stalls && basis->max_residual <= 1e-4))
-          << m.name << " " << residual_summary(*basis);
+      EXPECT_EQ(basis->status, SolveStatus::Converged) << m.name << " " << residual_summary(*basis);
       ASSERT_TRUE(basis->basis.allFinite()) << m.name;
       for (const Setting& s : settings()) {
         if (s.laplacian != laplacian) continue;

@@ -14,8 +14,8 @@
 #include <thread>
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <zip.h>
+#include <nlohmann/json.hpp>
 
 #include "pose.h"
 #include "preview.h"
@@ -23,6 +23,7 @@
 #include "specdeform/deform/influence.h"
 #include "specdeform/deform/scene.h"
 #include "specdeform/mesh/generate.h"
+#include "support/corpus.h"
 
 namespace specdeform::server {
 namespace {
@@ -169,6 +170,55 @@ TEST_F(EditorSessionTest, FramesMeetTheHandleTargets) {
   // The identity gives the rest shape back (to float precision).
   session_->handle(true, frame(Eigen::Affine3d::Identity(), 2));
   EXPECT_LT((last_frame() - rest_).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+// The editor on meshes as tools write them (support/corpus.h's messy(): zero-area faces and
+// vertices, fins, pinches, misoriented triangles, many pieces), with its own default options
+// (ARAP, the transfer factored before the frame): opened, a drag moves the handle to its target,
+// and back at the identity the frame is the rest, exactly.
+TEST(EditorSessionMessy, OpenAndDragEveryMessyMesh) {
+  for (const test::MessyMesh& m : test::messy()) {
+    std::vector<Sent> sent;
+    DeformOptions options = editor_deform_options();
+    options.background_transfer = false;
+    EditorSession session(EditorConfig{.modes = 30, .options = options},
+                          [&](bool binary, std::string data) {
+                            sent.push_back({binary, std::move(data)});
+                          });
+    LoadedMesh mesh;
+    mesh.mesh = m.mesh;
+    mesh.info = identity_read_info(mesh.mesh);
+    session.open(std::move(mesh), m.name + ".obj");
+    const Vertices& rest = m.mesh.V;
+    const double diagonal = bounding_box_diagonal(rest);
+    Selection selection;
+    selection.handles.resize(1);
+    const double top = rest.col(0).maxCoeff(), low = rest.col(0).minCoeff();
+    for (int i = 0; i < rest.rows(); ++i) {
+      if (rest(i, 0) > top - 0.1 * (top - low)) selection.handles[0].push_back(i);
+      if (rest(i, 0) < low + 0.1 * (top - low)) selection.fixed.push_back(i);
+    }
+    session.handle(true, encode_selection(plain(selection), Tag::Selection));
+    const auto frame = [&](const Eigen::Affine3d& t, uint32_t seq) {
+      session.handle(true, encode_frame({seq, {t}}));
+      for (auto it = sent.rbegin(); it != sent.rend(); ++it) {
+        if (it->binary && message_tag(it->data) == Tag::FrameResult) {
+          return decode_frame_positions(it->data, rest, nullptr);
+        }
+      }
+      return Vertices();
+    };
+    const Eigen::Affine3d drag = Eigen::Translation3d(0.0, 0.1 * diagonal, 0.05 * diagonal) *
+                                 Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ());
+    const Vertices bent = frame(drag, 1);
+    ASSERT_EQ(bent.rows(), rest.rows()) << m.name;
+    ASSERT_TRUE(bent.allFinite()) << m.name;
+    for (const int i : selection.handles[0]) {
+      EXPECT_LT((bent.row(i).transpose() - drag * rest.row(i).transpose()).norm(), 0.01 * diagonal)
+          << m.name << " " << i;
+    }
+    EXPECT_TRUE(frame(Eigen::Affine3d::Identity(), 2) == rest) << m.name;
+  }
 }
 
 // The transfer factored in the background (the editor's default): after a selection, frames

@@ -168,13 +168,20 @@ std::vector<MessyMesh> make_messy() {
     out.push_back(std::move(m));
   }
   {
-    // Two vertices at one place: the grid's corner copied, the copy used by the corner's face.
+    // Two vertices at one place, as Blender's doubles: a vertex copied, the copy taking its place
+    // in one of its faces and joined to it by a zero-area face (a zero-length edge).
     TriangleMesh grid = make_bumpy_plane({1.0, 10, 1, 0.03});
-    const int copy = grid.num_vertices();
+    const int copy = grid.num_vertices(), a = grid.F(0, 0);
     grid.V.conservativeResize(copy + 1, 3);
-    grid.V.row(copy) = grid.V.row(grid.F(0, 0));
+    grid.V.row(copy) = grid.V.row(a);
+    for (int f = 1; f < grid.num_faces(); ++f) {
+      const auto corner = std::find(grid.F.row(f).begin(), grid.F.row(f).end(), a);
+      if (corner == grid.F.row(f).end()) continue;
+      *corner = copy;
+      break;
+    }
     grid.F.conservativeResize(grid.num_faces() + 1, 3);
-    grid.F.row(grid.num_faces() - 1) << grid.F(0, 0), grid.F(0, 1), copy;
+    grid.F.row(grid.num_faces() - 1) << a, grid.F(0, 1), copy;
     MessyMesh m{"caps_and_needles", grid, {}};
     add_t_junctions(m, 3);
     // Each T-junction's vertex nudged off its edge by a hair: a cap, not a zero-area face.

@@ -36,8 +36,8 @@ const std::vector<CorpusMesh>& corpus();
 //    edge of three triangles) and a second sphere touching it at one vertex;
 //  - confetti: a bumpy bar among 60 specks of one triangle or four (thousands of pieces in
 //    game scenes);
-//  - caps_and_needles: a grid cut into caps (angles a hair below pi) with zero-length edges
-//    (two vertices at one place, both used).
+//  - caps_and_needles: a grid cut into caps (angles a hair below pi) with a zero-length edge
+//    (two vertices at one place, both in faces of their own, as Blender's doubles).
 struct MessyMesh {
   std::string name;
   TriangleMesh mesh;

@@ -17,6 +17,9 @@
 // (UnconstrainedPieces::Follow, deform/free_pieces.h), stays where it is (Keep) or is an
 // InputError.
 //
+// With every transform the identity, solve() returns the mesh bit for bit (every solver, energy
+// and detail method; a warm start is not taken there).
+//
 // With DeformOptions::single_solve the deformer solves once, releasing the basis before it
 // builds the details (basis() is then null): deform() below.
 //
