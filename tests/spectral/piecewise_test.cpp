@@ -49,6 +49,24 @@ TEST(PieceModes, ShareOfTheAreaWithAFloorAndALimit) {
   EXPECT_EQ(std::count(few.begin(), few.begin() + 400, 0), 400);
 }
 
+// The columns of dense basis stay within piece_basis_bytes: 1,899 teapots of 2,086 vertices
+// (3.96M) at m = 100 would take 16 m = 1,600 columns (51 GB); within 4 GB, 126 (the largest
+// pieces their constant, the smallest none), and never fewer than m.
+TEST(PieceModes, TheDenseColumnsFitTheMemoryBudget) {
+  const ManifoldHarmonicsPolicy policy;
+  std::vector<double> area(1899);
+  std::iota(area.begin(), area.end(), 1.0);
+  const std::vector<int> vertices(1899, 2086);
+  const std::vector<int> modes = detail::piece_modes(area, vertices, 100, policy);
+  const long long columns = std::accumulate(modes.begin(), modes.end(), 0LL);
+  EXPECT_EQ(columns, static_cast<long long>(policy.piece_basis_bytes / (8.0 * 1899 * 2086)));
+  EXPECT_EQ(std::count(modes.begin(), modes.end(), 0), 1899 - columns);
+  ManifoldHarmonicsPolicy tight = policy;
+  tight.piece_basis_bytes = 1e6;  // fewer than m columns' worth: m all the same
+  const std::vector<int> least = detail::piece_modes(area, vertices, 100, tight);
+  EXPECT_EQ(std::accumulate(least.begin(), least.end(), 0), 100);
+}
+
 // 100 identical spheres at m = 1000: eigenvalues of multiplicity 100 to 700 (the whole mesh's
 // shifts could not be placed among them). Piece by piece every sphere gets its own first 16
 // (its share, 10, is below the floor), the same as one sphere alone, M-orthonormal, each mode

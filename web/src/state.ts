@@ -65,6 +65,7 @@ export class EditorState {
   activeGroup = 0;
   frame: P.FrameResult | null = null; // the last one received
   measures: Measures | null = null; // of the full frame shown
+  private measuresAwaited: number | null = null; // the full frame whose measures are on their way
   notes: Note[] = [];
   drawMs = 0; // the full mesh's draw time
   diagonal = 1; // of the mesh's bounding box
@@ -263,6 +264,7 @@ export class EditorState {
       [!!this.server?.detail_pending, 'the detail'], [this.painting, 'a stroke'], [this.normalsBusy.full, 'normals'],
       [this.phase.kind === 'busy', 'busy'], [this.selectionHeld, 'a held selection'],
       [this.selectionsInFlight > 0, `${this.selectionsInFlight} selections in flight`],
+      [this.measuresAwaited !== null, `frame ${this.measuresAwaited}'s measures`],
     ];
     return waits.filter(([on]) => on).map(([, what]) => what);
   }
@@ -412,6 +414,7 @@ export class EditorState {
   // message's buffer holds other fields too).
   private computeFrame(slot: Slot, seq: number, scale: number, displacements: Int16Array): void {
     this.normalsBusy[slot] = true;
+    if (slot === 'full') this.measuresAwaited = seq;
     this.post({ kind: 'frame', slot, seq, scale, displacements: displacements.slice() });
   }
 
@@ -428,6 +431,7 @@ export class EditorState {
     }
     if (m.kind === 'measures') {
       if (m.seq === this.lastDrawn || m.seq === this.pendingDraw) this.measures = m.measures;
+      if (this.measuresAwaited !== null && m.seq >= this.measuresAwaited) this.measuresAwaited = null;
       return this.changed();
     }
     this.normalsBusy[m.slot] = false;
