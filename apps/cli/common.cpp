@@ -155,6 +155,16 @@ void add_write_options(CLI::App& cmd, WriteOptions& options) {
                  "the file's normals: follow (carried by each face's deformation, default), "
                  "recompute (from the new faces) or rotate (by each vertex's rotation)")
       ->transform(CLI::CheckedTransformer(kNormals, CLI::ignore_case));
+  static const auto kTargets = by_name({MorphTargets::Turn, MorphTargets::Keep});
+  cmd.add_option("--morph-targets", options.morph_targets,
+                 "a glTF's morph targets: turn (each delta turned with the surface at its "
+                 "vertex, default) or keep")
+      ->transform(CLI::CheckedTransformer(kTargets, CLI::ignore_case));
+  static const auto kJoints = by_name({Joints::Follow, Joints::Keep});
+  cmd.add_option("--joints", options.joints,
+                 "a glTF's skins: follow (joints move with the vertices they drive, with their "
+                 "inverse bind matrices, rest transforms and animation keys; default) or keep")
+      ->transform(CLI::CheckedTransformer(kJoints, CLI::ignore_case));
 }
 
 void write_result(const std::filesystem::path& path, const LoadedMesh& loaded, const Vertices& V,

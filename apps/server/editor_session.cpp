@@ -338,6 +338,9 @@ void EditorSession::text_message(std::string_view message) {
     const std::string format = j.value("format", own.empty() ? "obj" : own.substr(1));
     const std::filesystem::path out =
         std::filesystem::path(s.name).stem().string() + "-deformed." + format;
+    WriteOptions write;
+    write.morph_targets = morph_targets_from_name(j.value("morph_targets", "turn"));
+    write.joints = joints_from_name(j.value("joints", "follow"));
     const TriangleMesh file_order = to_file_order(s.loaded.info, result(true), s.loaded.mesh.F);
     if (!s.loaded.file) {  // a mesh made here (the demo)
       return send_(
@@ -345,7 +348,7 @@ void EditorSession::text_message(std::string_view message) {
     }
     // One download that works where it is saved: the file alone, or an archive of it with
     // every file it names (a .gltf's buffers and images, an OBJ's MTL and its images).
-    EncodedMesh encoded = encode_mesh_file(*s.loaded.file, file_order.V, out);
+    EncodedMesh encoded = encode_mesh_file(*s.loaded.file, file_order.V, out, write);
     for (const std::string& name : encoded.companions) {
       std::optional<std::string> bytes;
       try {
@@ -763,6 +766,11 @@ void EditorSession::send_ready() {
   const State& s = *state_;
   const SetupTimings& t = s.deformer->setup_timings();
   const PreparedBasis& b = s.basis();
+  FileSummary rig;
+  if (s.loaded.file &&
+      (s.loaded.file->format == MeshFormat::Gltf || s.loaded.file->format == MeshFormat::Glb)) {
+    rig = s.loaded.file->summary();
+  }
   send_(false, dump(Json{{"type", "ready"},
                          {"name", s.name},
                          {"vertices", s.loaded.mesh.num_vertices()},
@@ -790,7 +798,8 @@ void EditorSession::send_ready() {
                           {{"reduced_system", t.reduced_system},
                            {"detail_factorization", t.detail_factorization},
                            {"selection", t.selection}}},
-                         {"arap_clusters", s.deformer->rotation_clusters()}}));
+                         {"arap_clusters", s.deformer->rotation_clusters()},
+                         {"rig", {{"morph_targets", rig.morph_targets}, {"skins", rig.skins}}}}));
 }
 
 void EditorSession::send_selection() {

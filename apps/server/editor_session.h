@@ -18,7 +18,8 @@
 //     {"type": "undo"}, {"type": "redo"}
 //     {"type": "apply_pose"}         the shown result becomes the rest shape (pins become fixed)
 //     {"type": "preview", "vertices": k}   a coarse mesh for drags (preview.h)
-//     {"type": "export_mesh", "format": "obj|off|ply|stl|gltf|glb"}   answered with one file
+//     {"type": "export_mesh", "format": "obj|off|ply|stl|gltf|glb",
+//      "morph_targets": "turn|keep", "joints": "follow|keep"}   answered with one file
 //                                    message: the mesh, or a .zip of it with every file it names
 //                                    (a .gltf's buffers and images, an MTL and its images); without
 //                                    "format", the opened file's own, everything in it kept

@@ -46,7 +46,14 @@ class MeshReadInfo:
     def welded_vertices(self) -> int: ...
 
 class MeshFile:
-    def write(self, path: _Path, V: npt.ArrayLike, normals: str = "follow") -> list[str]: ...
+    def write(
+        self,
+        path: _Path,
+        V: npt.ArrayLike,
+        normals: str = "follow",
+        morph_targets: str = "turn",
+        joints: str = "follow",
+    ) -> list[str]: ...
     @property
     def info(self) -> MeshReadInfo: ...
     @property

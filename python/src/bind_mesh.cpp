@@ -141,7 +141,8 @@ void bind_mesh(py::module_& m) {
       .def(
           "write",
           [](const KeptFile& self, const std::filesystem::path& path, py::handle V,
-             const std::string& normals) {
+             const std::string& normals, const std::string& morph_targets,
+             const std::string& joints) {
             check_writable(path);
             const Vertices X = to_vertices(V);
             if (X.rows() != static_cast<Eigen::Index>(self.info.vertex_to_file.size())) {
@@ -149,17 +150,23 @@ void bind_mesh(py::module_& m) {
                                " rows, the mesh read from the file " +
                                std::to_string(self.info.vertex_to_file.size()) + " vertices");
             }
-            const WriteOptions options{normal_update_from_name(normals)};
+            const WriteOptions options{normal_update_from_name(normals),
+                                       morph_targets_from_name(morph_targets),
+                                       joints_from_name(joints)};
             py::gil_scoped_release release;
             const Vertices positions = to_file_order(self.info, X, Faces()).V;
             return write_mesh_file(path, *self.file, positions, options);
           },
           py::arg("path"), py::arg("V"), py::arg("normals") = "follow",
+          py::arg("morph_targets") = "turn", py::arg("joints") = "follow",
           R"(Writes the file again with the mesh's vertices at V (n, 3), in the format of path's
 extension, atomically: in the file's own format everything but positions and normals (glTF:
 POSITION with its min and max, NORMAL, TANGENT) as it was; in another, what that format can hold.
-normals: "follow" (carried by each face's deformation), "recompute" or "rotate". Returns notes on
-what was dropped or copied beside the output.)")
+normals: "follow" (carried by each face's deformation), "recompute" or "rotate". glTF rigs:
+morph_targets "turn" (each delta turned by its vertex's local rotation) or "keep"; joints "follow"
+(joints move with the vertices they drive; inverse bind matrices, rest transforms and animation
+keys with them) or "keep". Returns notes on what was dropped, changed or copied beside the
+output.)")
       .def_property_readonly(
           "info", [](const KeptFile& self) { return self.info; },
           "The MeshReadInfo: the map from the mesh to the file.")

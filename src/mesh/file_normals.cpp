@@ -1,6 +1,8 @@
 #include "file_normals.h"
 
+#include <array>
 #include <cmath>
+#include <map>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -81,20 +83,38 @@ Eigen::MatrixX3d recomputed(const FileAttributes& a, const Vertices& deformed,
                           });
 }
 
-// Each vertex's rotation nearest to the map of its polygon edges at rest to their deformed ones.
+}  // namespace
+
 std::vector<Eigen::Matrix3d> vertex_rotations(const FileAttributes& a, const Vertices& rest,
-                                              const Vertices& deformed) {
-  std::vector<Eigen::Matrix3d> cov(rest.rows(), Eigen::Matrix3d::Zero());
+                                              const Vertices& deformed, std::vector<char>& turned) {
+  // File vertices at the same rest position (split along seams and hard edges) share a ring.
+  std::map<std::array<double, 3>, int> welded;
+  std::vector<int> ring(rest.rows());
+  for (Eigen::Index v = 0; v < rest.rows(); ++v) {
+    ring[v] = welded.emplace(std::array{rest(v, 0), rest(v, 1), rest(v, 2)}, int(welded.size()))
+                  .first->second;
+  }
+  std::vector<Eigen::Matrix3d> cov(welded.size(), Eigen::Matrix3d::Zero());
+  std::vector<char> moved(welded.size(), 0);
   for_each_corner(a, [&](int, int, const Corner& c) {
     const Vec e = rest.row(c.next) - rest.row(c.v), d = deformed.row(c.next) - deformed.row(c.v);
-    cov[c.v] += d * e.transpose();
-    cov[c.next] += d * e.transpose();
+    const bool edge_moved =
+        rest.row(c.next) != deformed.row(c.next) || rest.row(c.v) != deformed.row(c.v);
+    for (const int v : {ring[c.v], ring[c.next]}) {
+      cov[v] += d * e.transpose();
+      moved[v] |= edge_moved;
+    }
   });
-  for (Eigen::Matrix3d& r : cov) r = r.isZero() ? Eigen::Matrix3d::Identity() : nearest_rotation(r);
-  return cov;
+  std::vector<Eigen::Matrix3d> out(rest.rows(), Eigen::Matrix3d::Identity());
+  turned.assign(rest.rows(), 0);
+  for (Eigen::Index v = 0; v < rest.rows(); ++v) {
+    const int r = ring[v];
+    if (!moved[r] || cov[r].isZero()) continue;
+    out[v] = nearest_rotation(cov[r]);
+    turned[v] = 1;
+  }
+  return out;
 }
-
-}  // namespace
 
 SharedNormals shared_normals(const FileAttributes& a, const Vertices& rest,
                              const Vertices& deformed, const Eigen::MatrixX3d& normals) {
@@ -147,7 +167,8 @@ Eigen::MatrixX3d updated_normals(const FileAttributes& a, const Vertices& rest,
           return angle(d) * n.normalized();
         });
   } else if (mode == NormalUpdate::Rotate) {
-    const std::vector<Eigen::Matrix3d> rotation = vertex_rotations(a, rest, deformed);
+    std::vector<char> turned;
+    const std::vector<Eigen::Matrix3d> rotation = vertex_rotations(a, rest, deformed, turned);
     sum = sum_over_corners(a, a.corner_normal, a.normals.rows(), moved, used,
                            [&](const Corner& c, int row) -> Vec {
                              return rotation[c.v] * a.normals.row(row).transpose();

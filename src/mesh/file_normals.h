@@ -10,6 +10,8 @@
 // normal, degenerate faces) takes the Recompute one, else keeps its value.
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "specdeform/mesh/mesh_file.h"
@@ -31,6 +33,13 @@ struct SharedNormals {
 };
 SharedNormals shared_normals(const FileAttributes& a, const Vertices& rest,
                              const Vertices& deformed, const Eigen::MatrixX3d& normals);
+
+// Each file vertex's local rotation: the rotation nearest to the map of its one-ring's rest edges
+// to their deformed ones (the polygon edges at the vertex, over every file vertex at the same rest
+// position: glTF and OBJ split vertices along seams). `turned[v]` is 0, and the rotation exactly
+// the identity, where no vertex of the ring moved.
+std::vector<Eigen::Matrix3d> vertex_rotations(const FileAttributes& a, const Vertices& rest,
+                                              const Vertices& deformed, std::vector<char>& turned);
 
 // Tangents with rows like a.normals' (glTF: one per split vertex), carried by the gradients of
 // the corners that use them, made orthogonal to `normals` (the updated normals) and unit.

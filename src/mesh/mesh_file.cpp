@@ -95,6 +95,26 @@ NormalUpdate normal_update_from_name(std::string_view text) {
   throw InputError("normals: '" + std::string(text) + "' is not follow, recompute or rotate");
 }
 
+std::string_view name(MorphTargets mode) {
+  return mode == MorphTargets::Turn ? "turn" : "keep";
+}
+
+std::string_view name(Joints mode) {
+  return mode == Joints::Follow ? "follow" : "keep";
+}
+
+MorphTargets morph_targets_from_name(std::string_view text) {
+  for (const MorphTargets m : {MorphTargets::Turn, MorphTargets::Keep})
+    if (name(m) == text) return m;
+  throw InputError("morph targets: '" + std::string(text) + "' is not turn or keep");
+}
+
+Joints joints_from_name(std::string_view text) {
+  for (const Joints m : {Joints::Follow, Joints::Keep})
+    if (name(m) == text) return m;
+  throw InputError("joints: '" + std::string(text) + "' is not follow or keep");
+}
+
 FileResolver folder_resolver(const std::filesystem::path& folder, Confinement confinement) {
   return [folder, confinement](const std::string& name) -> std::optional<std::string> {
     const std::filesystem::path relative(name);
@@ -296,7 +316,7 @@ EncodedMesh encode_mesh_file(const MeshFile& file, const Vertices& moved,
         taken.insert(input.filename().string());
         for (const std::string& name : companion_names(file)) taken.insert(name);
       }
-      EncodedMesh gltf = detail::rewrite_gltf(file, positions, normals, out_name, taken);
+      EncodedMesh gltf = detail::rewrite_gltf(file, positions, normals, out_name, taken, options);
       gltf.notes.insert(gltf.notes.begin(), out.notes.begin(), out.notes.end());
       return gltf;
     }

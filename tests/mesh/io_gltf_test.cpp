@@ -16,6 +16,7 @@
 #include "specdeform/exceptions.h"
 #include "specdeform/mesh/io.h"
 #include "specdeform/mesh/mesh_file.h"
+#include "support/gltf_model.h"
 
 namespace specdeform {
 namespace {
@@ -26,9 +27,7 @@ using Json = nlohmann::json;
 // side), POSITION and NORMAL interleaved in one buffer view, drawn by a node under a turned and
 // shifted parent; a triangle under a mirroring node; a line primitive; a mesh no node draws; an
 // image in a buffer view; extras.
-struct TestScene {
-  tinygltf::Model model;
-
+struct TestScene : test::GltfModel {
   TestScene() {
     model.asset.version = "2.0";
     model.buffers.emplace_back();
@@ -107,45 +106,6 @@ struct TestScene {
     model.scenes[0].nodes = {0, 2};
     model.defaultScene = 0;
     model.extras = tinygltf::Value(tinygltf::Value::Object{{"note", tinygltf::Value("kept")}});
-  }
-
-  template <typename T>
-  int view(const std::vector<T>& data, int stride = 0) {
-    std::vector<unsigned char>& b = model.buffers[0].data;
-    while (b.size() % 4) b.push_back(0);
-    tinygltf::BufferView v;
-    v.buffer = 0;
-    v.byteOffset = b.size();
-    v.byteLength = data.size() * sizeof(T);
-    v.byteStride = stride;
-    const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
-    b.insert(b.end(), bytes, bytes + v.byteLength);
-    model.bufferViews.push_back(v);
-    return int(model.bufferViews.size()) - 1;
-  }
-
-  int accessor(int view, size_t offset, size_t count, int type, int component) {
-    tinygltf::Accessor a;
-    a.bufferView = view;
-    a.byteOffset = offset;
-    a.count = count;
-    a.type = type;
-    a.componentType = component;
-    model.accessors.push_back(a);
-    return int(model.accessors.size()) - 1;
-  }
-
-  std::string glb() const {
-    std::ostringstream out;
-    tinygltf::TinyGLTF writer;
-    EXPECT_TRUE(writer.WriteGltfSceneToStream(&model, out, false, true));
-    return out.str();
-  }
-  std::string embedded() const {
-    std::ostringstream out;
-    tinygltf::TinyGLTF writer;
-    EXPECT_TRUE(writer.WriteGltfSceneToStream(&model, out, true, false));
-    return out.str();
   }
 };
 

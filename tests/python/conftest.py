@@ -2,6 +2,8 @@
 
 import os
 import pathlib
+import shutil
+import subprocess
 
 import numpy as np
 import pytest
@@ -42,3 +44,15 @@ def lumpy_sphere():
 def bar():
     """The demo model at a coarse resolution (2594 vertices)."""
     return specdeform.bumpy_bar(cells_per_unit=12)
+
+
+def blender_export(script: str, out: pathlib.Path, *args: str) -> pathlib.Path:
+    """Runs tests/files/`script` in Debian's Blender (`blender -b --factory-startup`), writing its
+    files to `out`; skips where Blender is not installed."""
+    blender = shutil.which("blender")
+    if blender is None:
+        pytest.skip("blender is not installed (scripts/setup.sh installs it)")
+    subprocess.run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+                    str(ROOT / "tests" / "files" / script), "--", str(out), *args],
+                   check=True, capture_output=True, timeout=600)
+    return out

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import specdeform
-from conftest import ROOT, SHARED
+from conftest import ROOT, SHARED, blender_export
 
 BLENDER_FILES = ["spot.obj", "spot.glb", "spot_colors.ply", "spot_colors.glb", "beast.obj",
                  "beast.glb", "cad_part.obj", "cad_part.glb"]
@@ -27,16 +27,10 @@ SHARED_FILES = ["gltf/polycam-scan.glb", "gltf/blender-monkey-display.glb",
 
 @pytest.fixture(scope="session")
 def assets(tmp_path_factory) -> pathlib.Path:
-    blender = shutil.which("blender")
-    if blender is None:
-        pytest.skip("blender is not installed (scripts/setup.sh installs it)")
     if not (SHARED / "models" / "spot.obj").exists():
         pytest.skip("the shared test meshes are absent")
-    out = tmp_path_factory.mktemp("blender")
-    subprocess.run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
-                    str(ROOT / "tests" / "files" / "export_assets.py"), "--", str(out),
-                    str(SHARED.parent)], check=True, capture_output=True, timeout=600)
-    return out
+    return blender_export("export_assets.py", tmp_path_factory.mktemp("blender"),
+                          str(SHARED.parent))
 
 
 def source(name: str, request) -> pathlib.Path:

@@ -7,14 +7,13 @@ byte for byte (the command line and Python), and a bend exits 0 with its handle 
 
 import json
 import pathlib
-import shutil
 import subprocess
 
 import numpy as np
 import pytest
 
 import specdeform
-from conftest import ROOT, SHARED
+from conftest import SHARED, blender_export
 
 MADE = ["scan.ply", "scan.obj", "cad.stl", "shells.obj", "room.glb"]
 SHARED_AWKWARD = ["awkward/wallhole.obj", "awkward/multibody.stl", "awkward/soup.stl",
@@ -23,14 +22,7 @@ SHARED_AWKWARD = ["awkward/wallhole.obj", "awkward/multibody.stl", "awkward/soup
 
 @pytest.fixture(scope="session")
 def made(tmp_path_factory) -> pathlib.Path:
-    blender = shutil.which("blender")
-    if blender is None:
-        pytest.skip("blender is not installed (scripts/setup.sh installs it)")
-    out = tmp_path_factory.mktemp("messy")
-    subprocess.run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
-                    str(ROOT / "tests" / "files" / "export_messy.py"), "--", str(out)],
-                   check=True, capture_output=True, timeout=600)
-    return out
+    return blender_export("export_messy.py", tmp_path_factory.mktemp("messy"))
 
 
 def source(name: str, request) -> pathlib.Path:

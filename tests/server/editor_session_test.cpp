@@ -315,6 +315,8 @@ TEST_F(EditorSessionTest, BadMessagesAreAnsweredAndChangeNothing) {
       {false, "not json", "text"},
       {false, R"({"type": "launch"})", "launch"},
       {false, R"({"type": "export_mesh", "format": "docx"})", "export_mesh"},
+      {false, R"({"type": "export_mesh", "morph_targets": "twist"})", "export_mesh"},
+      {false, R"({"type": "export_mesh", "joints": "stay"})", "export_mesh"},
       {false, R"({"type": "preview"})", "preview"},
       {false, R"({"type": "redo"})", "redo"},
   };

@@ -209,7 +209,10 @@ export class Panel {
       s.request({ type: 'export_mesh', ...exportFormat() }, 'export mesh', 'file'));
     const exportFormat = () => {
       const format = $<HTMLSelectElement>('export-format').value as P.ExportFormat | '';
-      return format === '' ? {} : { format };
+      const rig = $<HTMLInputElement>('export-rig').checked
+        ? {}
+        : ({ morph_targets: 'keep', joints: 'keep' } as const);
+      return format === '' ? rig : { format, ...rig };
     };
     $('export-scene').addEventListener('click', () => s.request({ type: 'export_scene' }, 'export scene', 'file'));
 
@@ -454,6 +457,8 @@ export class Panel {
     enable('undo', editable && !!s.server?.undo);
     enable('redo', editable && !!s.server?.redo);
     enable('export-scene', editable && (r?.pose ?? 0) === 0 && s.hasHandles());
+    $('export-rig-row').hidden = !r || (r.rig.morph_targets === 0 && r.rig.skins === 0);
+    enable('export-rig', editable);
     enable('apply-pose', editable && s.hasHandles());
     $('pose').textContent = r && r.pose > 0 ? `pose ${r.pose} applied` : '';
     document.querySelectorAll<HTMLButtonElement>('[data-tool]').forEach((b) => {

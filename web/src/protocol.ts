@@ -69,6 +69,7 @@ export interface ReadyMessage {
   };
   setup: { reduced_system: number; detail_factorization: number; selection: number };
   arap_clusters: number;
+  rig: { morph_targets: number; skins: number }; // a glTF's, which Export carries with the surface
 }
 
 export interface StateMessage {
@@ -110,7 +111,7 @@ export type ClientText =
   | { type: 'open_demo' | 'commit' | 'undo' | 'redo' | 'apply_pose' | 'export_scene' | 'cancel' }
   | ({ type: 'settings' } & Partial<Settings> & { modes?: number })
   | { type: 'preview'; vertices: number }
-  | { type: 'export_mesh'; format?: ExportFormat }; // none: the opened file's own
+  | { type: 'export_mesh'; format?: ExportFormat; morph_targets?: 'turn' | 'keep'; joints?: 'follow' | 'keep' }; // none: the opened file's own; the rig follows
 
 export type ExportFormat = 'obj' | 'off' | 'ply' | 'stl' | 'gltf' | 'glb';
 

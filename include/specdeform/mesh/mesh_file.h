@@ -161,8 +161,34 @@ enum class NormalUpdate {
 std::string_view name(NormalUpdate mode);
 NormalUpdate normal_update_from_name(std::string_view name);
 
+// How a glTF's morph targets follow a deformation of the rest shape.
+enum class MorphTargets {
+  Turn,  // each POSITION, NORMAL and TANGENT delta turned by its vertex's local rotation (the
+         // rotation nearest to the map of its welded one-ring's rest edges to their deformed
+         // ones), so a target does to the bent rest what it did to the unbent one, relative to
+         // the surface; deltas of vertices whose one-ring did not move keep their bytes
+  Keep,  // every delta as the file has it
+};
+
+// How a glTF's skins follow a deformation of the rest shape.
+enum class Joints {
+  Follow,  // each joint moved by the rigid motion that best maps the vertices it drives, weighted
+           // by their skin weights, to their new places; inverse bind matrices, rest transforms
+           // and the animation keys of moved joints updated together, so the bind pose is the
+           // deformed rest and each animation turns every part about its joint's new place
+  Keep,    // joints, inverse bind matrices and animations as the file has them
+};
+
+// "turn", "keep"; "follow", "keep". from_name throws InputError for anything else.
+std::string_view name(MorphTargets mode);
+std::string_view name(Joints mode);
+MorphTargets morph_targets_from_name(std::string_view name);
+Joints joints_from_name(std::string_view name);
+
 struct WriteOptions {
   NormalUpdate normals = NormalUpdate::Follow;
+  MorphTargets morph_targets = MorphTargets::Turn;  // glTF only
+  Joints joints = Joints::Follow;                   // glTF only
 };
 
 struct OutputFile {

@@ -12,8 +12,9 @@
 // (KHR_mesh_quantization) and sparse accessors are read.
 //
 // rewrite_gltf: the document with new positions (one row per file vertex, world space), normals
-// and tangents, in the container of `out_name` (.glb or .gltf), its changed buffers named after
-// it but never as one of `taken`: see gltf_rewriter.cpp.
+// and tangents, morph targets and skins as `options` say (gltf_rig.h), in the container of
+// `out_name` (.glb or .gltf), its changed buffers named after it but never as one of `taken`: see
+// gltf_rewriter.cpp.
 //
 // gltf_bytes: a mesh of another format as a new glTF (mesh_writers.h).
 #pragma once
@@ -55,7 +56,7 @@ PolygonSoup parse_gltf(std::string_view data, MeshFormat format, const std::stri
 
 EncodedMesh rewrite_gltf(const MeshFile& file, const Vertices& positions,
                          const Eigen::MatrixX3d& normals, const std::filesystem::path& out_name,
-                         const std::set<std::string>& taken);
+                         const std::set<std::string>& taken, const WriteOptions& options);
 
 // One mesh of one primitive per material: TEXCOORD_0 (v turned), NORMAL, COLOR_0, materials
 // with their base colour and image (embedded).
@@ -68,8 +69,8 @@ std::string gltf_bytes(const FileAttributes& a, const Vertices& X, const Eigen::
 void summarize_gltf_document(const GltfDocument& doc, FileSummary& s);
 void summarize_gltf(const GltfLayout& layout, FileSummary& s);
 // The document's summary of a file that parses but draws nothing deform can take (inspect).
-FileSummary gltf_document_summary(std::string_view data, MeshFormat format,
-                                  const std::string& name, const FileResolver& companions);
+FileSummary gltf_document_summary(std::string_view data, MeshFormat format, const std::string& name,
+                                  const FileResolver& companions);
 
 // Image `image`'s bytes and MIME type, wherever it lives (a buffer view, a data URI); nullopt
 // for one in a file (read it through the companions) or out of range.

@@ -456,6 +456,57 @@ std::optional<FloatSlots> float_slots(const GltfDocument& doc, int accessor) {
                     stride == 0 ? element : stride};
 }
 
+void write_floats(GltfDocument& doc, int accessor, const std::vector<float>& values,
+                  int components) {
+  const FloatSlots slots = *float_slots(doc, accessor);
+  GltfBuffer& buffer = doc.buffers[slots.buffer];
+  const size_t bytes = components * sizeof(float);
+  for (size_t i = 0; i < values.size() / components; ++i) {
+    char* at = buffer.bytes.data() + slots.offset + i * slots.stride;
+    if (std::memcmp(at, values.data() + i * components, bytes) != 0) {
+      std::memcpy(at, values.data() + i * components, bytes);
+      buffer.changed = true;
+    }
+  }
+}
+
+int add_float_accessor(GltfDocument& doc, int like, const std::vector<float>& values,
+                       int components, int target) {
+  Json a = doc.json["accessors"][like];
+  int buffer = -1;
+  if (a.contains("bufferView")) {
+    buffer = doc.json["bufferViews"][a["bufferView"].get<int>()].value("buffer", -1);
+  }
+  const std::string_view bytes(reinterpret_cast<const char*>(values.data()),
+                               values.size() * sizeof(float));
+  a["bufferView"] = doc.append_view(doc.data_buffer(buffer), bytes, target);
+  a.erase("byteOffset");
+  a.erase("sparse");
+  a.erase("normalized");
+  a["componentType"] = 5126;
+  a["count"] = values.size() / components;
+  set_float_bounds(a, values, components, false);
+  doc.json["accessors"].push_back(std::move(a));
+  return int(doc.json["accessors"].size()) - 1;
+}
+
+void set_float_bounds(Json& accessor, const std::vector<float>& values, int components,
+                      bool always) {
+  if (!always && !accessor.contains("min") && !accessor.contains("max")) return;
+  Json lo = Json::array(), hi = Json::array();
+  for (int k = 0; k < components; ++k) {
+    float a = INFINITY, b = -INFINITY;
+    for (size_t i = k; i < values.size(); i += components) {
+      a = std::min(a, values[i]);
+      b = std::max(b, values[i]);
+    }
+    lo.push_back(double(a));
+    hi.push_back(double(b));
+  }
+  accessor["min"] = std::move(lo);
+  accessor["max"] = std::move(hi);
+}
+
 EncodedDocument encode_gltf_document(const GltfDocument& doc) {
   Json json = doc.json;
   EncodedDocument out;

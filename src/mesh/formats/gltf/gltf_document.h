@@ -114,6 +114,21 @@ struct FloatSlots {
 };
 std::optional<FloatSlots> float_slots(const GltfDocument& doc, int accessor);
 
+// Writing float elements (`components` per element), for the rewriter and the rig:
+//  - write_floats: over float accessor `accessor`'s own elements (float_slots gives them); its
+//    buffer marked changed where a byte changed;
+//  - add_float_accessor: a new accessor like `like` (its type, name, bounds' presence) holding
+//    them in a new buffer view (`target`: 34962 vertices, 0 none) of the buffer `like`'s data is
+//    in, dense, not normalized; its index;
+//  - set_float_bounds: the accessor's min and max made those of `values` (where it has them, or
+//    `always`).
+void write_floats(GltfDocument& doc, int accessor, const std::vector<float>& values,
+                  int components);
+int add_float_accessor(GltfDocument& doc, int like, const std::vector<float>& values,
+                       int components, int target);
+void set_float_bounds(Json& accessor, const std::vector<float>& values, int components,
+                      bool always);
+
 // Components of a glTF accessor type ("VEC3" -> 3); 0 for an unknown one.
 int type_components(const std::string& type);
 // Bytes of a component type (5126 -> 4); 0 for an unknown one.

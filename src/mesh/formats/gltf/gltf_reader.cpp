@@ -9,6 +9,7 @@
 #include "data_uri.h"
 #include "gltf.h"
 #include "gltf_decode.h"
+#include "gltf_rig.h"
 #include "gltf_scene.h"
 #include "mesh/polygon_soup.h"
 #include "specdeform/exceptions.h"
@@ -348,6 +349,7 @@ void summarize_gltf_document(const GltfDocument& doc, FileSummary& s) {
                           " are written uncompressed where their positions change");
     }
   }
+  for (std::string& change : rig_changes(doc)) s.changes.push_back(std::move(change));
 }
 
 void summarize_gltf(const GltfLayout& layout, FileSummary& s) {

@@ -1,7 +1,10 @@
 // A kept glTF written again with new positions (gltf.h, rewrite_gltf).
 //
 // Each drawing of a primitive gets its POSITION, NORMAL and TANGENT elements in its mesh's own
-// space (through the inverse of its world matrix). An accessor keeps serving every drawing whose
+// space (through the inverse of its world matrix), and its morph targets' deltas of the same
+// three turned by each vertex's local rotation (MorphTargets::Turn: A^-1 R A d for positions and
+// tangents, A^T R A^-T d for normals, A the drawing's linear map, R the rotation in world space).
+// An accessor keeps serving every drawing whose
 // elements come out the same: one whose values did not change keeps its bytes (and the text of
 // its min and max); otherwise its first drawing's values are written in place when it is a
 // plain float accessor. Drawings whose values come out different (a mesh drawn by two nodes that
@@ -9,8 +12,8 @@
 // hold in place (quantised, sparse), get an accessor of their own in a new buffer view; the
 // primitives that draw them are re-pointed, a mesh drawn by nodes that now need different
 // accessors is copied for each of them and the nodes re-pointed, and everything else (indices,
-// texture coordinates, materials, morph targets, skins) stays shared. The min and max of every
-// accessor written are those of its new values.
+// texture coordinates, materials, skins, targets that did not turn) stays shared. The min and
+// max of every accessor written are those of its new values. Skins follow in gltf_rig.h.
 //
 // The container is `out_name`'s: a .glb's BIN chunk becomes `<out stem>.bin` in a .gltf; a
 // .gltf's buffers and images move into a .glb's BIN chunk; nothing else changes. A changed
@@ -27,6 +30,7 @@
 #include "data_uri.h"
 #include "gltf.h"
 #include "gltf_decode.h"
+#include "gltf_rig.h"
 #include "mesh/file_layout.h"
 #include "mesh/file_normals.h"
 #include "mesh/float_cast.h"
@@ -36,6 +40,12 @@ namespace specdeform::detail {
 namespace {
 
 enum Kind { kPosition, kNormal, kTangent };
+// An attribute of a primitive: its own (target -1) or morph target `target`'s delta.
+struct Slot {
+  int target = -1;
+  Kind kind = kPosition;
+  auto operator<=>(const Slot&) const = default;
+};
 constexpr const char* kAttribute[] = {"POSITION", "NORMAL", "TANGENT"};
 constexpr int kComponents[] = {3, 3, 4};
 
@@ -63,17 +73,6 @@ bool alike(const Floats& a, const Floats& b) {
   return gap <= 1e-6f * scale;
 }
 
-Json min_max(const Floats& values, int components, bool max) {
-  Json out = Json::array();
-  for (int k = 0; k < components; ++k) {
-    float m = max ? -INFINITY : INFINITY;
-    for (size_t i = k; i < values.size(); i += components)
-      m = max ? std::max(m, values[i]) : std::min(m, values[i]);
-    out.push_back(double(m));
-  }
-  return out;
-}
-
 std::string image_mime(const std::string& name) {
   std::string ext = std::filesystem::path(name).extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -89,86 +88,112 @@ class Rewriter {
   Rewriter(const MeshFile& file, const GltfLayout& layout, std::vector<std::string>& notes)
       : file_(file), layout_(layout), doc_(layout.doc), notes_(notes) {}
 
-  // Each drawing's new elements, kind by kind (empty where the kind is absent or not rewritten).
-  void compute(const Vertices& positions, const Eigen::MatrixX3d& normals) {
+  // Each drawing's elements, slot by slot (none where the slot is absent or not rewritten).
+  void compute(const Vertices& positions, const Eigen::MatrixX3d& normals, MorphTargets targets) {
     const Eigen::MatrixX3d tangents =
         layout_.tangents.rows() > 0 && normals.rows() > 0
             ? updated_tangents(file_.attributes, file_.rest, positions,
                                layout_.tangents.leftCols<3>(), normals)
             : Eigen::MatrixX3d();
+    std::vector<char> turned;
+    std::vector<Eigen::Matrix3d> rotation;
+    if (targets == MorphTargets::Turn && any_targets()) {
+      rotation = vertex_rotations(file_.attributes, file_.rest, positions, turned);
+    }
     values_.resize(layout_.units.size());
     for (size_t u = 0; u < layout_.units.size(); ++u) {
       const GltfUnit& unit = layout_.units[u];
       const Eigen::Matrix3d A = unit.world.topLeftCorner<3, 3>();
       const Eigen::Vector3d shift = unit.world.topRightCorner<3, 1>();
       const Eigen::PartialPivLU<Eigen::Matrix3d> inverse(A);
-      const auto fill = [&](Kind kind, int accessor, const auto& moved, const auto& local) {
+      const Eigen::Matrix3d A_inverse_T = inverse.inverse().transpose();
+      const auto fill = [&](Slot slot, int accessor, const auto& moved, const auto& local) {
         if (accessor < 0) return;
-        const Floats& rest = original(accessor, kind);
-        Floats& out = values_[u][kind];
-        out = rest;
+        const Floats& rest = original(accessor, slot.kind);
+        const int components = slot_components(slot);
+        if (rest.size() != size_t(unit.count) * components) {
+          doc_.fail("accessor " + std::to_string(accessor) + " (" + kAttribute[slot.kind] +
+                    ") does not have its primitive's " + std::to_string(unit.count) + " elements");
+        }
+        Floats out = rest;
         bool any = false;
         for (int i = 0; i < unit.count; ++i) {
           const int v = unit.first_vertex + i;
           if (!moved(v)) continue;
-          const Eigen::Vector3d x = local(v);
-          for (int k = 0; k < 3; ++k) {
-            out[size_t(i) * kComponents[kind] + k] = to_float(x[k], "a value");
-          }
+          const Eigen::Vector3d x = local(v, &rest[size_t(i) * components]);
+          for (int k = 0; k < 3; ++k) out[size_t(i) * components + k] = to_float(x[k], "a value");
           any = true;
         }
         // Directions that go from quantised (or compressed) storage into a new float accessor
         // are made unit where the storage rounded them (a quantised normal is not unit).
-        if (!any || kind == kPosition || float_slots(layout_.doc, accessor)) return;
-        for (size_t i = 0; i < out.size(); i += kComponents[kind]) {
-          const Eigen::Vector3f d = Eigen::Vector3f(&out[i]).normalized();
-          if (d.allFinite()) std::copy(d.data(), d.data() + 3, &out[i]);
+        if (any && slot.kind != kPosition && slot.target < 0 &&
+            !float_slots(layout_.doc, accessor)) {
+          for (size_t i = 0; i < out.size(); i += components) {
+            const Eigen::Vector3f d = Eigen::Vector3f(&out[i]).normalized();
+            if (d.allFinite()) std::copy(d.data(), d.data() + 3, &out[i]);
+          }
         }
+        values_[u][slot] = std::move(out);
       };
       fill(
-          kPosition, unit.position, [&](int v) { return positions.row(v) != file_.rest.row(v); },
-          [&](int v) {
+          {-1, kPosition}, unit.position,
+          [&](int v) { return positions.row(v) != file_.rest.row(v); },
+          [&](int v, const float*) {
             return Eigen::Vector3d(inverse.solve(positions.row(v).transpose() - shift));
           });
-      if (normals.rows() == 0) continue;
-      fill(
-          kNormal, unit.normal,
-          [&](int v) { return normals.row(v) != file_.attributes.normals.row(v); },
-          [&](int v) {
-            return Eigen::Vector3d((A.transpose() * normals.row(v).transpose()).normalized());
-          });
-      if (tangents.rows() == 0) continue;
-      fill(
-          kTangent, unit.tangent,
-          [&](int v) { return tangents.row(v) != layout_.tangents.row(v).head<3>(); },
-          [&](int v) {
-            return Eigen::Vector3d(inverse.solve(tangents.row(v).transpose()).normalized());
-          });
+      if (normals.rows() > 0) {
+        fill(
+            {-1, kNormal}, unit.normal,
+            [&](int v) { return normals.row(v) != file_.attributes.normals.row(v); },
+            [&](int v, const float*) {
+              return Eigen::Vector3d((A.transpose() * normals.row(v).transpose()).normalized());
+            });
+      }
+      if (tangents.rows() > 0) {
+        fill(
+            {-1, kTangent}, unit.tangent,
+            [&](int v) { return tangents.row(v) != layout_.tangents.row(v).head<3>(); },
+            [&](int v, const float*) {
+              return Eigen::Vector3d(inverse.solve(tangents.row(v).transpose()).normalized());
+            });
+      }
+      if (rotation.empty()) continue;
+      const Json& list = array_at(primitive(unit), "targets");
+      for (size_t t = 0; t < list.size(); ++t) {
+        for (const Kind kind : {kPosition, kNormal, kTangent}) {
+          fill(
+              {int(t), kind}, target_accessor(list[t], kind), [&](int v) { return turned[v] != 0; },
+              [&](int v, const float* rest) {
+                const Eigen::Vector3d d(rest[0], rest[1], rest[2]);
+                const Eigen::Matrix3d& R = rotation[v];
+                if (kind == kNormal)
+                  return Eigen::Vector3d(A.transpose() * (R * (A_inverse_T * d)));
+                return Eigen::Vector3d(inverse.solve(R * (A * d)));
+              });
+        }
+      }
     }
   }
 
-  // Which accessor serves each drawing's kind: the same, written in place, or a new one.
+  // Which accessor serves each drawing's slot: the same, written in place, or a new one.
   void assign() {
-    std::map<std::pair<int, Kind>, std::vector<size_t>> users;
+    std::map<int, std::vector<std::pair<size_t, Slot>>> users;  // accessor -> (unit, slot)
     for (size_t u = 0; u < layout_.units.size(); ++u) {
-      const GltfUnit& unit = layout_.units[u];
-      for (const Kind kind : {kPosition, kNormal, kTangent}) {
-        const int a = kind == kPosition ? unit.position
-                      : kind == kNormal ? unit.normal
-                                        : unit.tangent;
-        if (a >= 0 && !values_[u][kind].empty()) users[{a, kind}].push_back(u);
-      }
+      for (const auto& [slot, values] : values_[u])
+        users[accessor_of(u, slot)].emplace_back(u, slot);
     }
-    serving_.assign(layout_.units.size(), {-1, -1, -1});
-    for (const auto& [key, units] : users) {
-      const auto [accessor, kind] = key;
+    serving_.assign(layout_.units.size(), {});
+    for (const auto& [accessor, used] : users) {
+      const Kind kind = used.front().second.kind;
+      const int components = slot_components(used.front().second);
       // Classes of equal values, in drawing order.
       std::vector<const Floats*> classes;
       std::vector<size_t> class_of;
-      for (const size_t u : units) {
+      for (const auto& [u, slot] : used) {
+        const Floats& values = values_[u].at(slot);
         size_t c = 0;
-        while (c < classes.size() && !alike(*classes[c], values_[u][kind])) ++c;
-        if (c == classes.size()) classes.push_back(&values_[u][kind]);
+        while (c < classes.size() && !alike(*classes[c], values)) ++c;
+        if (c == classes.size()) classes.push_back(&values);
         class_of.push_back(c);
       }
       const Floats& rest = original(accessor, kind);
@@ -180,31 +205,35 @@ class Rewriter {
         if (c == unchanged) {
           target[c] = accessor;
         } else if (unchanged == classes.size() && c == 0 && float_slots(doc_, accessor)) {
-          write_in_place(accessor, kind, *classes[c]);
+          write_in_place(accessor, kind, components, *classes[c]);
           target[c] = accessor;
         } else {
-          target[c] = new_accessor(accessor, kind, *classes[c]);
+          target[c] = new_accessor(accessor, kind, components, *classes[c]);
         }
       }
-      for (size_t i = 0; i < units.size(); ++i) serving_[units[i]][kind] = target[class_of[i]];
+      for (size_t i = 0; i < used.size(); ++i) {
+        const auto [u, slot] = used[i];
+        serving_[u][slot] = target[class_of[i]];
+        if (slot.target >= 0 && class_of[i] != unchanged) {
+          turned_.insert({layout_.units[u].mesh, layout_.units[u].primitive, slot.target});
+        }
+      }
     }
   }
 
   // Primitives pointed at their drawings' new accessors; meshes copied where the nodes (or
   // instances) that draw them need different ones.
   void repoint() {
-    using Drawer = std::pair<int, int>;                             // node, instance
-    std::map<Drawer, std::map<std::pair<int, int>, int>> replaced;  // (accessor, kind) -> new
+    using Drawer = std::pair<int, int>;                              // node, instance
+    std::map<Drawer, std::map<std::pair<int, Slot>, int>> replaced;  // (accessor, slot) -> new
     std::map<Drawer, int> mesh_of;
     for (size_t u = 0; u < layout_.units.size(); ++u) {
       const GltfUnit& unit = layout_.units[u];
       const Drawer drawer{unit.node, unit.instance};
       mesh_of[drawer] = unit.mesh;
-      const int original[3] = {unit.position, unit.normal, unit.tangent};
-      for (const Kind kind : {kPosition, kNormal, kTangent}) {
-        if (serving_[u][kind] >= 0 && serving_[u][kind] != original[kind]) {
-          replaced[drawer][{original[kind], kind}] = serving_[u][kind];
-        }
+      for (const auto& [slot, accessor] : serving_[u]) {
+        const int was = accessor_of(u, slot);
+        if (accessor != was) replaced[drawer][{was, slot}] = accessor;
       }
     }
     // Each drawer's mesh as it needs it.
@@ -212,13 +241,18 @@ class Rewriter {
     for (const auto& [drawer, mesh] : mesh_of) {
       Json own = doc_.json["meshes"][mesh];
       if (const auto r = replaced.find(drawer); r != replaced.end()) {
-        for (Json& prim : own["primitives"]) {
-          Json& attributes = prim["attributes"];
+        const auto repoint = [&](Json& attributes, int target) {
           for (const Kind kind : {kPosition, kNormal, kTangent}) {
             if (!attributes.contains(kAttribute[kind])) continue;
-            const auto it = r->second.find({attributes[kAttribute[kind]].get<int>(), kind});
+            const auto it =
+                r->second.find({json_index(attributes[kAttribute[kind]]), Slot{target, kind}});
             if (it != r->second.end()) attributes[kAttribute[kind]] = it->second;
           }
+        };
+        for (Json& prim : own["primitives"]) {
+          repoint(prim["attributes"], -1);
+          if (!prim.contains("targets")) continue;
+          for (size_t t = 0; t < prim["targets"].size(); ++t) repoint(prim["targets"][t], int(t));
         }
       }
       drawn[mesh].emplace_back(drawer, std::move(own));
@@ -258,13 +292,23 @@ class Rewriter {
     int expanded = 0;
     for (const auto& [node, meshes] : instanced) expanded += draw_instances(doc_, node, meshes);
     if (created_ > 0) {
-      notes_.push_back(
-          std::to_string(created_) +
-          " POSITION, NORMAL or TANGENT accessors added where drawings that shared one "
-          "came out different or the original could not hold the new values; " +
-          std::to_string(copies) +
-          " meshes copied for the nodes that draw them, everything else still shared "
-          "(the output's vertex numbering follows its own meshes)");
+      notes_.push_back(std::to_string(created_) +
+                       " POSITION, NORMAL or TANGENT accessors (or morph target deltas) added "
+                       "where drawings that shared one "
+                       "came out different or the original could not hold the new values; " +
+                       std::to_string(copies) +
+                       " meshes copied for the nodes that draw them, everything else still shared "
+                       "(the output's vertex numbering follows its own meshes)");
+    }
+    if (!turned_.empty()) {
+      std::set<std::pair<int, int>> all, turned;  // (mesh, target)
+      for (const GltfUnit& unit : layout_.units)
+        for (size_t t = 0; t < array_at(primitive(unit), "targets").size(); ++t)
+          all.insert({unit.mesh, int(t)});
+      for (const auto& [mesh, prim, t] : turned_) turned.insert({mesh, t});
+      notes_.push_back(std::to_string(turned.size()) + " of " + std::to_string(all.size()) +
+                       " morph targets turned with the surface (their deltas by each vertex's "
+                       "local rotation; --morph-targets keep leaves them)");
     }
     if (expanded > 0) {
       notes_.push_back(std::to_string(expanded) +
@@ -272,6 +316,12 @@ class Rewriter {
                        "instance (their instances came out different)");
     }
     for (std::string& note : uncompress_changed_draco(doc_, layout_.doc.json)) {
+      notes_.push_back(std::move(note));
+    }
+  }
+
+  void follow_joints(const Vertices& positions) {
+    for (std::string& note : detail::follow_joints(doc_, layout_, file_.rest, positions)) {
       notes_.push_back(std::move(note));
     }
   }
@@ -311,6 +361,36 @@ class Rewriter {
   }
 
  private:
+  bool any_targets() const {
+    return std::any_of(layout_.units.begin(), layout_.units.end(), [&](const GltfUnit& unit) {
+      return !array_at(primitive(unit), "targets").empty();
+    });
+  }
+
+  const Json& primitive(const GltfUnit& unit) const {
+    return doc_.json["meshes"][unit.mesh]["primitives"][unit.primitive];
+  }
+
+  static int target_accessor(const Json& target, Kind kind) {
+    return target.is_object() && target.contains(kAttribute[kind])
+               ? json_index(target[kAttribute[kind]])
+               : -1;
+  }
+
+  // The accessor the file gives drawing `u`'s slot.
+  int accessor_of(size_t u, Slot slot) const {
+    const GltfUnit& unit = layout_.units[u];
+    if (slot.target >= 0) {
+      return target_accessor(array_at(primitive(unit), "targets")[slot.target], slot.kind);
+    }
+    return slot.kind == kPosition ? unit.position
+           : slot.kind == kNormal ? unit.normal
+                                  : unit.tangent;
+  }
+
+  // Elements' components: 3, and 4 for a primitive's own TANGENT (morph targets' are 3).
+  static int slot_components(Slot slot) { return slot.target < 0 ? kComponents[slot.kind] : 3; }
+
   const Floats& original(int accessor, Kind kind) {
     auto it = original_.find(accessor);
     if (it == original_.end()) {
@@ -321,44 +401,16 @@ class Rewriter {
     return it->second;
   }
 
-  void set_bounds(Json& accessor, Kind kind, const Floats& values) {
-    if (kind != kPosition && !accessor.contains("min") && !accessor.contains("max")) return;
-    accessor["min"] = min_max(values, kComponents[kind], false);
-    accessor["max"] = min_max(values, kComponents[kind], true);
+  void write_in_place(int accessor, Kind kind, int components, const Floats& values) {
+    write_floats(doc_, accessor, values, components);
+    set_float_bounds(doc_.json["accessors"][accessor], values, components, kind == kPosition);
   }
 
-  void write_in_place(int accessor, Kind kind, const Floats& values) {
-    const FloatSlots slots = *float_slots(doc_, accessor);
-    GltfBuffer& buffer = doc_.buffers[slots.buffer];
-    const int components = kComponents[kind];
-    for (size_t i = 0; i < values.size() / components; ++i) {
-      char* at = buffer.bytes.data() + slots.offset + i * slots.stride;
-      if (std::memcmp(at, values.data() + i * components, components * sizeof(float)) != 0) {
-        std::memcpy(at, values.data() + i * components, components * sizeof(float));
-        buffer.changed = true;
-      }
-    }
-    set_bounds(doc_.json["accessors"][accessor], kind, values);
-  }
-
-  int new_accessor(int accessor, Kind kind, const Floats& values) {
-    Json a = doc_.json["accessors"][accessor];
-    int buffer = -1;
-    if (a.contains("bufferView")) {
-      buffer = doc_.json["bufferViews"][a["bufferView"].get<int>()].value("buffer", -1);
-    }
-    const std::string_view bytes(reinterpret_cast<const char*>(values.data()),
-                                 values.size() * sizeof(float));
-    a["bufferView"] = doc_.append_view(doc_.data_buffer(buffer), bytes, 34962);
-    a.erase("byteOffset");
-    a.erase("sparse");
-    a.erase("normalized");
-    a["componentType"] = 5126;
-    a["count"] = values.size() / kComponents[kind];
-    set_bounds(a, kind, values);
-    doc_.json["accessors"].push_back(std::move(a));
+  int new_accessor(int accessor, Kind kind, int components, const Floats& values) {
+    const int a = add_float_accessor(doc_, accessor, values, components, 34962);
+    set_float_bounds(doc_.json["accessors"][a], values, components, kind == kPosition);
     ++created_;
-    return int(doc_.json["accessors"].size()) - 1;
+    return a;
   }
 
   // A .gltf's buffers and images moved into one BIN chunk (buffers without bytes, meshopt's
@@ -438,9 +490,10 @@ class Rewriter {
   const GltfLayout& layout_;
   GltfDocument doc_;
   std::vector<std::string>& notes_;
-  std::vector<std::array<Floats, 3>> values_;  // per unit, per kind
-  std::vector<std::array<int, 3>> serving_;    // per unit, per kind: the accessor
+  std::vector<std::map<Slot, Floats>> values_;  // per unit, per rewritten slot: its values
+  std::vector<std::map<Slot, int>> serving_;    // per unit, per rewritten slot: the accessor
   std::map<int, Floats> original_;
+  std::set<std::array<int, 3>> turned_;  // morph targets changed: (mesh, primitive, target)
   int created_ = 0;
 };
 
@@ -448,13 +501,14 @@ class Rewriter {
 
 EncodedMesh rewrite_gltf(const MeshFile& file, const Vertices& positions,
                          const Eigen::MatrixX3d& normals, const std::filesystem::path& out_name,
-                         const std::set<std::string>& taken) {
+                         const std::set<std::string>& taken, const WriteOptions& options) {
   const GltfLayout& layout = std::get<GltfLayout>(file.layout->format);
   EncodedMesh out;
   Rewriter rewriter(file, layout, out.notes);
-  rewriter.compute(positions, normals);
+  rewriter.compute(positions, normals, options.morph_targets);
   rewriter.assign();
   rewriter.repoint();
+  if (options.joints == Joints::Follow) rewriter.follow_joints(positions);
   const GltfContainer container =
       mesh_format_from_path(out_name) == MeshFormat::Glb ? GltfContainer::Glb : GltfContainer::Gltf;
   const GltfDocument doc = rewriter.finish(container, out_name.stem().string(), taken);
