@@ -16,6 +16,7 @@
 
 #include "common.h"
 #include "specdeform/exceptions.h"
+#include "specdeform/version.h"
 
 namespace {
 
@@ -42,7 +43,7 @@ int main(int argc, char** argv) {
   CLI::App app{"specdeform: detail-preserving spectral deformation of triangle meshes",
                "specdeform"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "specdeform 0.1.0");
+  app.set_version_flag("--version", "specdeform " + std::string(specdeform::version()));
   specdeform::cli::add_info_command(app);
   specdeform::cli::add_basis_command(app);
   specdeform::cli::add_smooth_command(app);

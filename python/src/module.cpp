@@ -5,6 +5,7 @@
 
 #include "bindings.h"
 #include "specdeform/exceptions.h"
+#include "specdeform/version.h"
 
 namespace py = pybind11;
 
@@ -27,7 +28,7 @@ PyObject* add_exception(py::module_& m, const char* name, py::handle bases, cons
 
 PYBIND11_MODULE(_specdeform, m) {
   m.doc() = "specdeform's compiled core; use the package `specdeform`.";
-  m.attr("__version__") = SPECDEFORM_VERSION;
+  m.attr("__version__") = std::string(specdeform::version());
   // CHOLMOD prints its warnings on stdout through SuiteSparse's printf hook; here the library's
   // exceptions report what went wrong.
   SuiteSparse_config.printf_func = nullptr;

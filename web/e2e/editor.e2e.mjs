@@ -460,6 +460,7 @@ try {
     await labelOverTexture();
     await page.screenshot({ path: resolve(args.out, 'textured.png') });
     await page.selectOption('#export-format', '');
+    check(!(await page.isVisible('#export-rig')), 'a glTF without morph targets or skins shows no "rig follows"');
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#export-mesh')]);
     check(download.suggestedFilename() === 'cube-deformed.glb', `exported as a .glb (${download.suggestedFilename()})`);
     check(readFileSync(await download.path()).equals(readFileSync(glb)), 'the exported .glb, nothing moved, is the opened one');

@@ -214,6 +214,7 @@ export class Panel {
         : ({ morph_targets: 'keep', joints: 'keep' } as const);
       return format === '' ? rig : { format, ...rig };
     };
+    $('export-format').addEventListener('change', () => this.render());
     $('export-scene').addEventListener('click', () => s.request({ type: 'export_scene' }, 'export scene', 'file'));
 
     renderKeymap($<HTMLTableElement>('keymap-table'));
@@ -457,7 +458,9 @@ export class Panel {
     enable('undo', editable && !!s.server?.undo);
     enable('redo', editable && !!s.server?.redo);
     enable('export-scene', editable && (r?.pose ?? 0) === 0 && s.hasHandles());
-    $('export-rig-row').hidden = !r || (r.rig.morph_targets === 0 && r.rig.skins === 0);
+    // The rig follows a glTF written as a glTF ("as opened" or either container).
+    const gltf = ['', 'gltf', 'glb'].includes($<HTMLSelectElement>('export-format').value);
+    $('export-rig-row').hidden = !r || !gltf || (r.rig.morph_targets === 0 && r.rig.skins === 0);
     enable('export-rig', editable);
     enable('apply-pose', editable && s.hasHandles());
     $('pose').textContent = r && r.pose > 0 ? `pose ${r.pose} applied` : '';

@@ -308,7 +308,7 @@ class Rewriter {
       for (const auto& [mesh, prim, t] : turned_) turned.insert({mesh, t});
       notes_.push_back(std::to_string(turned.size()) + " of " + std::to_string(all.size()) +
                        " morph targets turned with the surface (their deltas by each vertex's "
-                       "local rotation; --morph-targets keep leaves them)");
+                       "local rotation; morph targets \"keep\" leaves them)");
     }
     if (expanded > 0) {
       notes_.push_back(std::to_string(expanded) +

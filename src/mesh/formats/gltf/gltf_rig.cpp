@@ -15,6 +15,11 @@ namespace specdeform::detail {
 
 namespace {
 
+// "1 joint", "4 joints".
+std::string counted(size_t n, const std::string& noun) {
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
+}
+
 // A rigid motion x -> R x + t.
 struct Rigid {
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
@@ -340,10 +345,10 @@ class Follower {
           std::to_string(followed_) + " of " + std::to_string(bind_.size()) +
           " joints followed the surface they drive (their inverse bind matrices with them); the "
           "rest transforms of " +
-          std::to_string(correction_.size()) + " joints and " + std::to_string(channels_) +
-          " animation channels (in " + std::to_string(animations_.size()) +
-          " animations) updated, so each part turns about its joint's new place (--joints keep "
-          "leaves the skins as they were)");
+          counted(correction_.size(), "joint") + " and " + counted(channels_, "animation channel") +
+          " (in " + counted(animations_.size(), "animation") +
+          ") updated, so each part turns about its joint's new place (joints \"keep\" leaves "
+          "the skins as they were)");
     }
     if (!skipped_.empty()) {
       std::string names;
@@ -404,16 +409,16 @@ std::vector<std::string> rig_changes(const GltfDocument& doc) {
   if (targets > 0) {
     out.push_back(std::to_string(targets) +
                   " morph targets (over the primitives): their deltas turn with the surface "
-                  "where it turns (--morph-targets keep leaves them)");
+                  "where it turns (morph targets \"keep\" leaves them)");
   }
   const Json& skins = array_at(doc.json, "skins");
   if (!skins.empty()) {
     std::set<int> joints;
     for (const Json& skin : skins)
       for (const Json& j : array_at(skin, "joints")) joints.insert(json_index(j));
-    out.push_back(std::to_string(skins.size()) + " skins, " + std::to_string(joints.size()) +
-                  " joints: the joints of moved vertices follow them, with their inverse bind "
-                  "matrices, rest transforms and animation keys (--joints keep leaves them)");
+    out.push_back(counted(skins.size(), "skin") + " of " + counted(joints.size(), "joint") +
+                  ": the joints of moved vertices follow them, with their inverse bind "
+                  "matrices, rest transforms and animation keys (joints \"keep\" leaves them)");
   }
   return out;
 }
