@@ -33,8 +33,22 @@ root = Path(__file__).resolve().parent
 
 
 def project_version():
+    """cmake/version.cmake's rule: CMakeLists.txt's VERSION at a commit tagged v<VERSION>, else
+    <VERSION>+g<commit>; an sdist's own (its PKG-INFO), where there is no git."""
+    pkg_info = root / "PKG-INFO"
+    if pkg_info.exists():
+        return re.search(r"^Version: (\S+)$", pkg_info.read_text(), re.M).group(1)
     text = (root / "CMakeLists.txt").read_text()
-    return re.search(r"project\(specdeform VERSION ([0-9.]+)", text).group(1)
+    version = re.search(r"project\(specdeform VERSION ([0-9.]+)", text).group(1)
+    git = ["git", "-C", str(root)]
+    try:
+        commit = subprocess.run(git + ["rev-parse", "--short=8", "HEAD"], check=True,
+                                capture_output=True, text=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return version
+    tagged = subprocess.run(git + ["describe", "--tags", "--exact-match", "--match",
+                                   f"v{version}", "HEAD"], capture_output=True).returncode == 0
+    return version if tagged else f"{version}+g{commit}"
 
 
 class CMakeBuild(build_ext):
@@ -46,8 +60,10 @@ class CMakeBuild(build_ext):
             self._cmake("-S", root, "-B", build_dir, "-DCMAKE_BUILD_TYPE=Release",
                         f"-DPython_EXECUTABLE={sys.executable}", "-DSPECDEFORM_BUILD_SERVER=OFF",
                         "-DSPECDEFORM_BUILD_CLI=OFF", "-DSPECDEFORM_BUILD_TESTS=OFF",
-                        "-DSPECDEFORM_BUILD_BENCHMARKS=OFF", "-DSPECDEFORM_BUILD_PYTHON=ON")
-        self._cmake("--build", build_dir, "--target", "_specdeform", "-j", str(os.cpu_count()))
+                        "-DSPECDEFORM_BUILD_BENCHMARKS=OFF", "-DSPECDEFORM_BUILD_PYTHON=ON",
+                        f"-DSPECDEFORM_VERSION_FULL={project_version()}")
+        self._cmake("--build", build_dir, "--target", "_specdeform", "-j", str(os.cpu_count()),
+                    "--", "--no-print-directory")
         suffix = sysconfig.get_config_var("EXT_SUFFIX")
         built = build_dir / "python" / "specdeform" / f"_specdeform{suffix}"
         if not built.exists():

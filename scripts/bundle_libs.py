@@ -5,9 +5,12 @@ bundle LIBS_DIR ELF...   copies every shared library the ELF files need beyond t
     (glibc, libstdc++, libgcc_s) into LIBS_DIR under a name unique to its content
     (libcholmod.so.3 -> libcholmod-1a2b3c4d.so.3, so that a host which loaded its own copy, such as
     Blender, keeps it), renames the copies' sonames and every NEEDED entry to match, and points
-    each file's RUNPATH at LIBS_DIR through $ORIGIN. Needs ldd and patchelf.
+    each file's RUNPATH at LIBS_DIR through $ORIGIN. Each copy's licence goes beside it, as its
+    Debian package states it: LIBS_DIR/LICENSES/<copy>.copyright (/usr/share/doc/<package>/
+    copyright, the package found by dpkg -S). Needs ldd, patchelf and dpkg.
 check DIR                lists each NEEDED entry of an ELF file under DIR that is neither in the
-    system's base nor a file under DIR found through the file's RUNPATH; exit status 1 if any.
+    system's base nor a file under DIR found through the file's RUNPATH, and each bundled copy
+    (a library in a *.libs folder) without its licence; exit status 1 if any.
 hidden ELF...            prints the system paths of the libraries `bundle` would copy (a test
     hides them to show that the bundled module loads without them).
 
@@ -77,6 +80,10 @@ def bundle(libs_dir, elfs):
         copy.chmod(0o755)
         _patchelf("--set-soname", copy.name, copy)
         copies.append(copy)
+    licences = libs_dir / "LICENSES"
+    licences.mkdir()
+    for soname, path in dependencies.items():
+        shutil.copyfile(_copyright(path), licences / f"{renamed[soname]}.copyright")
     for elf in elfs + copies:
         replacements = []
         for name in _needed(elf):
@@ -86,6 +93,18 @@ def bundle(libs_dir, elfs):
             _patchelf(*replacements, elf)
         origin = os.path.relpath(libs_dir, elf.parent)
         _patchelf("--set-rpath", "$ORIGIN" if origin == "." else f"$ORIGIN/{origin}", elf)
+
+
+def _copyright(path):
+    """The copyright file of the Debian package that installed `path`."""
+    for candidate in (path, path.resolve(), Path(str(path.resolve()).replace("/usr/lib/", "/lib/"))):
+        out = subprocess.run(["dpkg", "-S", str(candidate)], capture_output=True, text=True)
+        if out.returncode == 0:
+            package = out.stdout.split(":")[0]
+            copyright = Path("/usr/share/doc") / package / "copyright"
+            if copyright.is_file():
+                return copyright
+    raise SystemExit(f"bundle_libs: no Debian copyright file found for {path}")
 
 
 def _is_elf(path):
@@ -108,6 +127,9 @@ def check(root):
             inside = [d / name for d in dirs if d.is_relative_to(root)]
             if not any(candidate.is_file() for candidate in inside):
                 problems.append(f"{path.relative_to(root)} needs {name}, not bundled")
+        if path.parent.name.endswith(".libs") and \
+                not (path.parent / "LICENSES" / f"{path.name}.copyright").is_file():
+            problems.append(f"{path.relative_to(root)} has no licence in LICENSES/")
     for problem in problems:
         print(problem)
     return 1 if problems else 0

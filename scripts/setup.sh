@@ -11,7 +11,7 @@ build=${1:-build}
 packages=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libopenblas-dev
           libspectra-dev libcli11-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev libboost-dev
           libcgal-dev libtinygltf-dev libdraco-dev libmeshoptimizer-dev libzip-dev python3-dev pybind11-dev python3-numpy python3-scipy python3-pytest
-          python3-matplotlib python3-pip python3-venv patchelf blender xvfb)
+          python3-matplotlib python3-pip python3-venv python3-build patchelf lintian blender xvfb)
 command -v npm >/dev/null || packages+=(nodejs npm)
 scripts/apt_install.sh "${packages[@]}"
 [ "$build" = --packages ] && exit 0

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """specdeform for Blender: spectral mesh deformation (Rong, Cao & Guo 2008) driven by an object.
 
 A thin adapter over the compiled `specdeform` module: Bind computes (or loads from the cache the

@@ -1,7 +1,8 @@
-"""Spectral mesh deformation (Rong, Cao & Guo 2008) for numpy and scipy.
+"""Spectral mesh deformation (Rong, Cao & Guo 2008) for numpy.
 
 Meshes are plain arrays: V float64 (n, 3), F integer (f, 3). Operators come back as
-scipy.sparse matrices, bases as read-only views that share the solver's memory.
+scipy.sparse matrices (cotan_stiffness and mass_matrix: the only functions that need scipy, an
+optional dependency), bases as read-only views that share the solver's memory.
 
     import specdeform
     V, F = specdeform.read_mesh("bar.off")      # or V, F, file = read_mesh("a.glb", keep=True)

@@ -190,9 +190,18 @@ py::object to_scipy(Eigen::SparseMatrix<double>&& matrix) {
                           owner);
   const py::array indptr(py::dtype::of<int>(), {cols + 1}, {sizeof(int)}, owned->outerIndexPtr(),
                          owner);
-  return py::module_::import("scipy.sparse")
-      .attr("csc_matrix")(py::make_tuple(data, indices, indptr),
-                          py::arg("shape") = py::make_tuple(owned->rows(), cols));
+  py::module_ sparse;
+  try {
+    sparse = py::module_::import("scipy.sparse");
+  } catch (const py::error_already_set& e) {
+    if (!e.matches(PyExc_ImportError)) throw;
+    throw py::import_error(
+        "this function returns a scipy.sparse matrix, and scipy is not installed (pip install "
+        "'specdeform[scipy]', or Debian's python3-scipy); the rest of specdeform needs numpy "
+        "only");
+  }
+  return sparse.attr("csc_matrix")(py::make_tuple(data, indices, indptr),
+                                   py::arg("shape") = py::make_tuple(owned->rows(), cols));
 }
 
 }  // namespace specdeform::python

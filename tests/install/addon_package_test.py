@@ -1,7 +1,8 @@
-"""The add-on's two zips as an artist gets them (issue 45): the add-on for Blender 3.4-4.1 (its
-folder at the top) and the extension for Blender 4.2+ (blender_manifest.toml at the top) carry the
-same files; every compiled file in them needs only what they carry or glibc, libstdc++, libgcc
-and libm; the manifest holds to Blender's documented schema (version 1.0.0, as Blender's own
+"""The add-on's two zips as an artist gets them (issues 45, 55): the add-on for Blender 3.4-4.1
+(its folder at the top) and the extension for Blender 4.2+ (blender_manifest.toml at the top)
+carry the same files; every compiled file in them needs only what they carry or glibc,
+libstdc++, libgcc and libm, and each library they carry has its licence beside it, the project's
+LICENSE at the top; the manifest holds to Blender's documented schema (version 1.0.0, as Blender's own
 `extension validate` checks it); the add-on imports its own modules relatively, as an extension
 must (it is loaded as bl_ext.<repository>.specdeform).
 
@@ -31,8 +32,10 @@ assert "blender_manifest.toml" in files and "__init__.py" in files, files
 modules = [f for f in files if f.startswith("lib/specdeform/_specdeform.cpython-311")]
 assert modules, "no module for Python 3.11 (Blender 3.4 and 4.2-4.5) in the add-on"
 
+# Every bundled library with its licence (bundle_libs.py check), the project's at the top.
 for root in (addon, extension):
     assert subprocess.run([sys.executable, bundle_libs, "check", root]).returncode == 0, root
+assert "GNU GENERAL PUBLIC LICENSE" in (addon / "LICENSE").read_text()
 
 # The manifest, by the rules of Blender's extension schema 1.0.0.
 manifest = tomllib.loads((extension / "blender_manifest.toml").read_text())

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# The Debian package (issue 45): `cpack -G DEB` makes it from the build; its dependencies name
-# Debian's packages (dpkg-shlibdeps); unpacked (dpkg-deb -x, as apt would lay it out under /), its
-# program runs `demo` from another folder, Debian's python3 imports its module, and Debian's
-# Blender lists its add-on, which loads that module.
+# The Debian packages (issues 45, 55): `cpack -G DEB` makes specdeform and specdeform-dev from the
+# build; their dependencies name Debian's packages (dpkg-shlibdeps; the -dev packages the CMake
+# package finds); each carries a machine-readable copyright and a changelog, its version is the
+# program's, and lintian finds no error; unpacked (dpkg-deb -x, as apt would lay them out under
+# /), the program runs `demo` from another folder, Debian's python3 imports its module, and
+# Debian's Blender lists its add-on, which loads that module.
 # Usage: deb_test.sh BUILD_DIR WORK_DIR [BLENDER]
 set -euo pipefail
 build=$1 work=$2 blender=${3:-}
@@ -12,20 +14,42 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 echo "-- cpack"
 (cd "$build" && cpack -G DEB -B "$work" >/dev/null) || fail "cpack"
 deb=$(ls "$work"/specdeform_*_amd64.deb) || fail "no .deb"
+dev=$(ls "$work"/specdeform-dev_*_amd64.deb) || fail "no -dev .deb"
 depends=$(dpkg-deb -f "$deb" Depends)
 echo "Depends: $depends"
 for package in libcholmod3 libopenblas0 libtinygltf2d libzip4 python3-numpy; do
   [[ $depends == *"$package"* ]] || fail "Depends lacks $package"
 done
+dev_depends=$(dpkg-deb -f "$dev" Depends)
+for package in libeigen3-dev libcgal-dev libsuitesparse-dev libtinygltf-dev; do
+  [[ $dev_depends == *"$package"* ]] || fail "specdeform-dev's Depends lacks $package"
+done
+version=$("$build"/bin/specdeform --version | cut -d' ' -f2)
+for d in "$deb" "$dev"; do
+  [ "$(dpkg-deb -f "$d" Version)" = "$version" ] || fail "$d's version is not $version"
+  [[ $(dpkg-deb -f "$d" Maintainer) == *"<"*@*">" ]] || fail "$d's Maintainer has no address"
+done
+if command -v lintian >/dev/null; then
+  errors=$(lintian "$deb" "$dev" 2>/dev/null | grep '^E:' || true)
+  [ -z "$errors" ] || fail "lintian: $errors"
+  echo "lintian: no error"
+fi
 
 echo "-- unpacked"
 root="$work/root"
 dpkg-deb -x "$deb" "$root"
+dpkg-deb -x "$dev" "$root"
 for f in usr/bin/specdeform usr/share/specdeform/web/index.html usr/lib/libspecdeform.a \
          usr/lib/cmake/specdeform/specdeformConfig.cmake \
-         usr/share/blender/scripts/addons/specdeform_blender/__init__.py; do
-  [ -e "$root/$f" ] || fail "$f is not in the package"
+         usr/share/blender/scripts/addons/specdeform_blender/__init__.py \
+         usr/share/doc/specdeform/changelog.gz usr/share/doc/specdeform-dev/changelog.gz; do
+  [ -e "$root/$f" ] || fail "$f is not in the packages"
 done
+for p in specdeform specdeform-dev; do
+  head -1 "$root/usr/share/doc/$p/copyright" | grep -q copyright-format/1.0 ||
+    fail "$p's copyright is not machine-readable"
+done
+dpkg-deb -c "$deb" | grep -q 'usr/lib/libspecdeform.a' && fail "the library is in the program's package"
 [ ! -e "$root/usr/share/blender/scripts/addons/specdeform_blender/lib" ] ||
   fail "the package's add-on carries its own module"
 mkdir -p "$work/elsewhere"

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# The Python wheel as a Python user gets it (issue 45): `pip wheel` builds it from the checkout
+# The Python wheel as a Python user gets it (issues 45, 55): `pip wheel` builds it from the checkout
 # (reusing BUILD_DIR's CMake build, so only the module is relinked when changed); every compiled
-# file in it needs only what it carries or glibc and libstdc++; it installs into a fresh venv
+# file in it needs only what it carries or glibc and libstdc++, each library it carries has its
+# licence beside it, its metadata has the LICENSE, the licence and the program's version, and
+# scipy only as an extra; it installs into a fresh venv
 # (--system-site-packages, for Debian's numpy) and deforms a mesh there, run from another folder
 # with the system's copies of the libraries it bundles hidden.
 # Usage: wheel_test.sh BUILD_DIR SOURCE_DIR WORK_DIR
@@ -19,7 +21,18 @@ echo "$(basename "$wheel"): $(du -k "$wheel" | cut -f1) KiB"
 
 echo "-- what the wheel carries"
 $python -m zipfile -e "$wheel" "$work/unpacked"
-$python "$source/scripts/bundle_libs.py" check "$work/unpacked" || fail "unbundled libraries"
+$python "$source/scripts/bundle_libs.py" check "$work/unpacked" ||
+  fail "unbundled libraries, or bundled ones without their licence"
+grep -q "GNU GENERAL PUBLIC LICENSE" "$work"/unpacked/specdeform-*.dist-info/LICENSE ||
+  fail "no LICENSE in the wheel's metadata"
+grep -q "^License: GPL-3.0-or-later" "$work"/unpacked/specdeform-*.dist-info/METADATA ||
+  fail "the wheel's metadata names no licence"
+version=$("$build"/bin/specdeform --version | cut -d' ' -f2)
+grep -qx "Version: $version" "$work"/unpacked/specdeform-*.dist-info/METADATA ||
+  fail "the wheel's version is not the program's $version"
+if grep "^Requires-Dist: scipy" "$work"/unpacked/specdeform-*.dist-info/METADATA | grep -vq "extra =="; then
+  fail "the wheel requires scipy (optional: the extra 'scipy')"
+fi
 
 echo "-- a fresh venv, the build tree and the system's libraries out of sight"
 $python -m venv --system-site-packages "$work/venv"

@@ -1,5 +1,8 @@
 """The operators as scipy.sparse matrices: K and M against their defining formulas."""
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 import scipy.sparse
@@ -56,3 +59,30 @@ def test_matrices_own_their_arrays(bar):
     data = K.data
     del K
     assert np.isfinite(data).all() and data.flags.writeable
+
+
+def test_without_scipy_only_the_matrices_need_it(tmp_path):
+    """scipy is optional: with it out of sight, the matrices' functions say what to install and
+    the rest deforms with numpy alone."""
+    script = """
+import sys
+sys.modules["scipy"] = None  # an import of scipy now fails, as where it is not installed
+import numpy as np
+import specdeform
+V, F = specdeform.bumpy_bar()
+try:
+    specdeform.cotan_stiffness(V, F)
+    raise SystemExit("cotan_stiffness without scipy did not fail")
+except ImportError as e:
+    assert "scipy is not installed" in str(e) and "specdeform[scipy]" in str(e), e
+d = specdeform.SpectralDeformer(V, F, modes=20)
+top, bottom = np.flatnonzero(V[:, 0] > V[:, 0].max() - 0.05), np.flatnonzero(V[:, 0] < V[:, 0].min() + 0.05)
+d.set_selection(handles=[top], fixed=bottom)
+T = np.eye(4)
+T[2, 3] = 0.2
+assert np.isfinite(d.solve([T])).all()
+print("ok")
+"""
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         timeout=300)
+    assert run.returncode == 0 and run.stdout.strip() == "ok", run.stderr
