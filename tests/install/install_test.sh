@@ -4,7 +4,8 @@
 #  - into a prefix P: P/bin/specdeform runs `demo` from another folder and `edit` serves the
 #    installed page; a consumer project (tests/install/consumer) finds specdeform::core with
 #    find_package, builds and runs, and the same through pkg-config; Debian's python3 imports
-#    the installed package.
+#    the installed package;
+#  - into ~/.local (the README's prefix): Debian's python3 imports it with no PYTHONPATH.
 # Usage: install_test.sh CMAKE BUILD_DIR SOURCE_DIR WORK_DIR
 set -euo pipefail
 cmake=$1 build=$2 source=$3 work=$4
@@ -59,10 +60,17 @@ c++ -std=c++20 -O1 "$source/tests/install/consumer/main.cpp" -o "$work/pkg-consu
 "$work/pkg-consumer"
 
 echo "-- Python"
-site=$(find "$prefix" -path '*dist-packages/specdeform/__init__.py' -not -path '*blender*')
+site=$(find "$prefix" -path '*site-packages/specdeform/__init__.py' -not -path '*blender*')
 [ -n "$site" ] || fail "no Python package under the prefix"
 (cd "$work/elsewhere" && env -u PYTHONPATH PYTHONPATH="$(dirname "$(dirname "$site")")" /usr/bin/python3 -c \
   'import specdeform; V, F = specdeform.icosphere(2); print(specdeform.manifold_harmonics(V, F, 4)[0].round(3))') \
   | grep -q "0. 2. 2. 2." || fail "the installed Python package"
 [ -f "$prefix/share/specdeform/blender/specdeform_blender/__init__.py" ] || fail "no add-on"
+
+echo "-- the README's prefix ~/.local: Debian's python3 finds the module with no PYTHONPATH"
+home="$work/home"
+HOME="$home" "$cmake" --install "$build" --prefix "$home/.local" --component python >/dev/null
+(cd "$work/elsewhere" && env -u PYTHONPATH HOME="$home" /usr/bin/python3 -c \
+  'import specdeform; print(specdeform.__file__)') | grep -q "^$home/.local/lib/python3" ||
+  fail "Debian's python3 does not find the module installed under ~/.local"
 echo "install: ok"
