@@ -1017,6 +1017,46 @@ try {
     await keys('Alt+h');
     check((await api(() => window.specdeformEditor.hidden())).length === 0 && (await api(() => window.specdeformEditor.drawnTriangles())) === all,
       'Alt+H shows every triangle again');
+    // Shift+H hides the unlabelled vertices (Blender's hide unselected); Alt+H shows them again.
+    const labelled = await api(() => window.specdeformEditor.labels());
+    const free = labelled.filter((l) => l === 0).length;
+    await keys('Shift+h');
+    const unselected = await api(() => window.specdeformEditor.hidden());
+    check(free > 0 && free < labelled.length && unselected.length === free && unselected.every((v) => labelled[v] === 0),
+      `Shift+H hides the ${free} unlabelled vertices, no labelled one (${unselected.length} hidden)`);
+    await keys('Alt+h');
+    // An armed H ends with the next key (here Tab), says so, and the next drag does not hide.
+    await keys('h');
+    check(!(await page.isHidden('#header')), 'H arms the box hide (its header shown)');
+    await keys('Tab', 'Tab');
+    check(await page.isHidden('#header'), 'another key disarms H (its header gone)');
+    check((await page.textContent('#notes')).includes('hide disarmed by'), 'the disarming is said');
+    await page.mouse.move(on.x - 60, on.y - 40);
+    await page.mouse.down();
+    await page.mouse.move(on.x + 60, on.y + 40, { steps: 4 });
+    await page.mouse.up();
+    await waitReady(60000);
+    check((await api(() => window.specdeformEditor.hidden())).length === 0, 'the drag after a disarmed H hides nothing');
+    await keys('Control+z');
+    await waitReady(60000);
+    // A menu closed (Esc) or just focused takes no key: numpad keys turn the view, letters do
+    // not step its value by type-ahead.
+    const viewNow = () => api(() => JSON.stringify([window.specdeformEditor.cameraPosition(), window.specdeformEditor.cameraTarget()]));
+    for (const menu of ['#navigation', '#energy', '#pivot', '#export-format', '#detail']) {
+      const value = await page.inputValue(menu);
+      const seen = await viewNow();
+      // Each key with the menu focused: R (type-ahead would pick "right ..."; here it starts a
+      // rotation, which Esc cancels), Down (would step it), Esc (leaves it), Numpad 6 (turns).
+      for (const k of ['r', 'ArrowDown', 'Escape', 'Numpad6']) {
+        await page.focus(menu);
+        await keys(k);
+        if (k === 'r') await keys('Escape');
+      }
+      check((await page.inputValue(menu)) === value, `${menu} keeps ${value} after keys aimed at the view (${await page.inputValue(menu)})`);
+      check((await viewNow()) !== seen, `Numpad6 turned the view with ${menu} focused`);
+      check(await page.evaluate(() => !document.activeElement || document.activeElement === document.body), `${menu} handed the keyboard back`);
+      await keys('Numpad4');
+    }
     cover('hide');
 
     log('keys: a missed press said at the pointer');

@@ -102,6 +102,7 @@ export class Interaction {
   }
 
   setTool(t: Tool): void {
+    this.disarm(`the ${t} tool`);
     if (t !== 'move') this.paintTool = t;
     this.tool = t;
     if (t !== 'move') this.s.viewer.gizmo.detach();
@@ -634,6 +635,34 @@ export class Interaction {
     this.region = { armed: true, lasso: false, hide: true, path: [] };
     this.showHeader(`Hide (${this.xray ? 'X-ray: through the surface' : 'visible vertices only'}): ` +
       'drag a rectangle over what to hide; Esc cancels; Alt+H reveals');
+  }
+
+  // Shift+H, Blender's hide unselected: every vertex without a label (and its triangles) hidden,
+  // to see and paint among the labelled parts. Alt+H reveals them.
+  hideUnselected(): void {
+    if (!this.s.ready || this.stroke || this.drag) return;
+    const free: number[] = [];
+    this.s.labels.forEach((l, v) => l === FREE && free.push(v));
+    if (free.length === this.s.labels.length) {
+      return this.s.note('nothing is labelled: Shift+H hides what is not (paint a handle or a fixed part first)');
+    }
+    if (free.length === 0) return this.s.note('every vertex is labelled: nothing to hide');
+    const total = this.s.viewer.setHidden(free);
+    this.s.note(`${free.length.toLocaleString()} unlabelled vertices hidden (${total.toLocaleString()} in all; Alt+H reveals them)`);
+    this.s.changed();
+  }
+
+  // Whether a one-click mode (box select, hide, select linked) waits for its click or drag.
+  get armed(): boolean {
+    return this.region.armed || this.linkedArmed;
+  }
+
+  // Ends an armed one-click mode because of `by` (a key, another tool), saying so.
+  disarm(by: string): void {
+    if (!this.armed) return;
+    const what = this.linkedArmed ? 'select linked' : this.region.hide ? 'hide' : 'box select';
+    this.cancel();
+    this.s.note(`${what} disarmed by ${by}`);
   }
 
   reveal(): void {

@@ -19,7 +19,7 @@ export const KEYMAP: KeyRow[] = [
   { id: 'box', keys: 'B, then a left drag / Ctrl + right drag', does: 'box / lasso select (visible vertices; with X-ray, Alt + Z, through the surface)' },
   { id: 'invert', keys: 'Ctrl + I', does: 'invert (the tool\'s label and the free vertices swap)' },
   { id: 'grow', keys: 'Ctrl + numpad + / −', does: 'grow / shrink by a ring (also Ctrl + = / Ctrl + −)' },
-  { id: 'hide', keys: 'H, then a left drag / Alt + H', does: 'hide the vertices in a rectangle, to paint behind them (visible ones; with X-ray all) / show everything again' },
+  { id: 'hide', keys: 'H, then a left drag / Shift + H / Alt + H', does: 'hide the vertices in a rectangle, to paint behind them (visible ones; with X-ray all) / hide every unlabelled vertex / show everything again; any other key or tool disarms H' },
   { id: 'orbit', keys: 'middle drag / Shift + middle / Ctrl + middle', does: 'orbit / pan / zoom (Alt + left drag as the middle button with "Alt emulates middle")' },
   { id: 'wheel', keys: 'wheel', does: 'zoom towards the pointer; while moving with a region of influence: widen or narrow it' },
   { id: 'views', keys: 'numpad 1, 3, 7 (Ctrl: opposite) / 9', does: 'look from the front, right, top (back, left, bottom) / from the other side' },

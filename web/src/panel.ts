@@ -24,12 +24,14 @@ const MESH_FILE = /\.(obj|off|ply|stl|gltf|glb)$/i;
 const NAVIGATION_KEY = 'specdeform.navigation';
 const kOrbitStep = 15; // degrees a numpad 4, 6, 8 or 2 turns the view (Blender's default)
 
-// Keys typed into a text field (or a menu) stay there; every other control hands the keyboard back
-// to the view once used, so that a key acts whatever was clicked last, as in Blender.
+// Keys typed into a text field stay there; every other control hands the keyboard back to the
+// view once used, so that a key acts whatever was clicked last, as in Blender. A menu (a select)
+// takes keys only while it is open (its popup has them then); closed, a key that reaches it acts
+// on the view and never steps its value.
 const TEXT_INPUTS = new Set(['text', 'number', 'search', 'email', 'password', 'url', 'tel']);
 const typing = (t: EventTarget | null): boolean =>
-  t instanceof HTMLTextAreaElement || t instanceof HTMLSelectElement ||
-  (t instanceof HTMLInputElement && TEXT_INPUTS.has(t.type));
+  t instanceof HTMLTextAreaElement || (t instanceof HTMLInputElement && TEXT_INPUTS.has(t.type));
+const MODIFIERS = new Set(['Shift', 'Control', 'Alt', 'Meta', 'CapsLock', 'NumLock']);
 function releaseFocus(e: Event): void {
   const t = e.target;
   if (t instanceof HTMLElement && t !== document.body && !typing(t)) t.blur();
@@ -301,7 +303,16 @@ export class Panel {
   private key(e: KeyboardEvent): void {
     if (typing(e.target)) return;
     if ($<HTMLDialogElement>('confirm').open) return;
+    if (e.target instanceof HTMLSelectElement) {
+      // Tab leaves it; Enter, Space and Alt+Down open it, as a keyboard user asks.
+      if (e.key === 'Tab' || e.key === 'Enter' || e.key === ' ' || (e.altKey && e.key === 'ArrowDown')) return;
+      e.preventDefault(); // no type-ahead, no arrow stepping a closed menu's value
+      e.target.blur();
+      if (e.key === 'Escape') return;
+    }
     if (this.ui.modalKey(e)) return e.preventDefault();
+    // An armed one-click mode ends with any other key than Esc (which cancels it below).
+    if (this.ui.armed && !MODIFIERS.has(e.key) && e.key !== 'Escape') this.ui.disarm(`"${e.key}"`);
     const key = e.key.toLowerCase();
     const s = this.s;
     const ctrl = e.ctrlKey || e.metaKey;
@@ -349,6 +360,10 @@ export class Panel {
     } else if (e.altKey && key === 'h') {
       e.preventDefault();
       this.ui.reveal();
+    } else if (e.shiftKey && key === 'h' && !ctrl) {
+      this.ui.hideUnselected();
+    } else if ((key === 'x' || e.key === 'Delete') && !ctrl && !e.altKey) {
+      s.note('nothing is deleted here: Erase (3) clears labels, H or Shift+H hides, Alt+A clears the tool\'s label');
     } else if (e.key === 'Tab' && !ctrl && !e.altKey) {
       e.preventDefault(); // as Blender's Tab: between painting and moving
       this.ui.setTool(this.ui.tool === 'move' ? this.ui.paintTool : 'move');
