@@ -959,6 +959,15 @@ try {
       check(Math.abs(turned - degrees) < 1e-6 && moved < 1e-9 * diagonal && Math.abs(distance) < 1e-9,
         `${key} orbits by ${degrees} degrees about the target (${turned}; target moved ${moved}, distance changed by ${distance})`);
     }
+    // Numpad 5: orthographic and back; the model under the middle of the view is picked through
+    // either, at the same place (the frame's height kept at the orbit's centre).
+    const middle = () => api((c) => window.specdeformEditor.onModel(c.x, c.y), canvas);
+    const picked = await middle();
+    await keys('Numpad5');
+    check((await api(() => window.specdeformEditor.projection())) === 'orthographic', 'numpad 5 switches to an orthographic view');
+    check((await middle()) === picked, 'the middle of the view picks as before in the orthographic view');
+    await keys('Numpad5');
+    check((await api(() => window.specdeformEditor.projection())) === 'perspective', 'numpad 5 switches back');
     cover('views', 'turn');
 
     log('keys: N, Shift+N');

@@ -44,8 +44,9 @@ export function corners(r: Rect): Point[] {
 
 export function verticesIn(viewer: Viewer, contains: (x: number, y: number) => boolean, xray: boolean, diagonal: number): number[] {
   const p = viewer.positions();
-  const camera = viewer.camera;
-  camera.updateMatrixWorld(); // moved since the last draw, perhaps
+  const camera = viewer.view;
+  const forward = viewer.camera.getWorldDirection(new THREE.Vector3());
+  const depth = (q: THREE.Vector3) => q.clone().sub(camera.position).dot(forward); // along the view
   const bounds = viewer.canvas.getBoundingClientRect();
   const v = new THREE.Vector3();
   const out: number[] = [];
@@ -60,7 +61,7 @@ export function verticesIn(viewer: Viewer, contains: (x: number, y: number) => b
     if (!xray) {
       const hit = viewer.pick(x, y);
       const at = new THREE.Vector3(p[3 * k], p[3 * k + 1], p[3 * k + 2]);
-      if (!hit || hit.point.distanceTo(camera.position) < at.distanceTo(camera.position) - 2e-3 * diagonal) continue;
+      if (!hit || depth(hit.point) < depth(at) - 2e-3 * diagonal) continue;
     }
     out.push(k);
   }

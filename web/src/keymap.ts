@@ -22,7 +22,7 @@ export const KEYMAP: KeyRow[] = [
   { id: 'hide', keys: 'H, then a left drag / Shift + H / Alt + H', does: 'hide the vertices in a rectangle, to paint behind them (visible ones; with X-ray all) / hide every unlabelled vertex / show everything again; any other key or tool disarms H' },
   { id: 'orbit', keys: 'middle drag / Shift + middle / Ctrl + middle', does: 'orbit / pan / zoom (Alt + left drag as the middle button with "Alt emulates middle")' },
   { id: 'wheel', keys: 'wheel', does: 'zoom towards the pointer; while moving with a region of influence: widen or narrow it' },
-  { id: 'views', keys: 'numpad 1, 3, 7 (Ctrl: opposite) / 9', does: 'look from the front, right, top (back, left, bottom) / from the other side' },
+  { id: 'views', keys: 'numpad 1, 3, 7 (Ctrl: opposite) / 9 / 5', does: 'look from the front, right, top (back, left, bottom) / from the other side / perspective or orthographic' },
   { id: 'turn', keys: 'numpad 4, 6 / 8, 2', does: 'orbit left, right / up, down by 15°' },
   { id: 'frame', keys: 'F or numpad . / Home', does: 'frame the active group / the whole mesh' },
   { id: 'panel', keys: 'N', does: 'show or hide the panel' },

@@ -60,6 +60,7 @@ const viewer = state.viewer;
   notes: () => state.notes.map((n) => ({ ...n })),
   cameraPosition: () => viewer.camera.position.toArray(),
   cameraTarget: () => viewer.orbit.target.toArray(),
+  projection: () => (viewer.orthographic ? 'orthographic' : 'perspective'),
   measures: () => state.measures,
   look: () => ({ present: viewer.look.present, drawn: viewer.drawingLook, textures: viewer.look.textures }),
   cursor: () => interaction.cursor?.toArray() ?? null,

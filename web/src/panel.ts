@@ -320,7 +320,7 @@ export class Panel {
     const turns: Record<string, [number, number]> = { Numpad4: [-kOrbitStep, 0], Numpad6: [kOrbitStep, 0],
       Numpad8: [0, kOrbitStep], Numpad2: [0, -kOrbitStep], Numpad9: [180, 0] };
     // Disconnected, only the view keys act.
-    const viewKey = views[e.code] !== undefined || turns[e.code] !== undefined || e.code === 'NumpadDecimal' ||
+    const viewKey = views[e.code] !== undefined || turns[e.code] !== undefined || e.code === 'NumpadDecimal' || e.code === 'Numpad5' ||
       e.key === 'Home' || e.key === 'Escape' || e.key === '?' || (key === 'n' && !e.shiftKey);
     if (s.phase.kind === 'disconnected' && !viewKey) {
       if (e.key.length === 1) s.note(`"${e.key}" does nothing while disconnected: the edit waits for the server`);
@@ -333,6 +333,9 @@ export class Panel {
     } else if (turns[e.code]) {
       e.preventDefault();
       s.viewer.orbitBy(...turns[e.code]);
+    } else if (e.code === 'Numpad5') {
+      e.preventDefault();
+      s.note(`${s.viewer.toggleProjection()} view (numpad 5 switches back)`);
     } else if (e.key === '?') {
       this.toggleKeymap();
     } else if (e.code === 'NumpadDecimal') {

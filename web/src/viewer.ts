@@ -22,7 +22,11 @@ export type Navigation = 'blender' | 'right';
 
 export class Viewer {
   readonly renderer: THREE.WebGLRenderer;
+  // The camera the controls move; numpad 5 draws and picks through an orthographic one that
+  // follows it (`view`), its frame as high as the perspective one's at the orbit's target.
   readonly camera = new THREE.PerspectiveCamera(40, 1, 0.01, 100);
+  private readonly ortho = new THREE.OrthographicCamera();
+  orthographic = false;
   readonly orbit: OrbitControls;
   navigation: Navigation = 'blender';
   readonly gizmo: TransformControls;
@@ -387,7 +391,7 @@ export class Viewer {
       this.bvh.refit();
       this.bvhStale = false;
     }
-    this.raycaster.setFromCamera(this.ndc(clientX, clientY), this.camera);
+    this.raycaster.setFromCamera(this.ndc(clientX, clientY), this.view);
     const hidden = this.hiddenMask;
     const hit = hidden
       ? this.bvh.raycast(this.raycaster.ray, THREE.DoubleSide).sort((a, b) => a.distance - b.distance)
@@ -408,21 +412,20 @@ export class Viewer {
 
   // A world point's position in client (CSS pixel) coordinates.
   toScreen(point: THREE.Vector3): { x: number; y: number } {
-    this.camera.updateMatrixWorld();
     const rect = this.canvas.getBoundingClientRect();
-    const v = point.clone().project(this.camera);
+    const v = point.clone().project(this.view);
     return { x: rect.left + ((v.x + 1) / 2) * rect.width, y: rect.top + ((1 - v.y) / 2) * rect.height };
   }
 
   // The ray from the camera through (clientX, clientY).
   ray(clientX: number, clientY: number): THREE.Ray {
-    this.raycaster.setFromCamera(this.ndc(clientX, clientY), this.camera);
+    this.raycaster.setFromCamera(this.ndc(clientX, clientY), this.view);
     return this.raycaster.ray.clone();
   }
 
   // The world point under (clientX, clientY) on the plane through `through` facing the camera.
   onViewPlane(clientX: number, clientY: number, through: THREE.Vector3): THREE.Vector3 | null {
-    this.raycaster.setFromCamera(this.ndc(clientX, clientY), this.camera);
+    this.raycaster.setFromCamera(this.ndc(clientX, clientY), this.view);
     const normal = this.camera.getWorldDirection(new THREE.Vector3());
     const plane = new THREE.Plane().setFromNormalAndCoplanarPoint(normal, through);
     return this.raycaster.ray.intersectPlane(plane, new THREE.Vector3());
@@ -499,7 +502,7 @@ export class Viewer {
   // version of the drawn content (changedContent); a requested draw that would show the same is
   // not made (a full draw of a million triangles takes most of a second without a GPU).
   private showing(): string {
-    const c = this.camera, g = this.gizmo as TransformControls & { dragging: boolean };
+    const c = this.view, g = this.gizmo as TransformControls & { dragging: boolean };
     const gizmo = g.object ? [g.mode, g.axis, g.dragging, g.size, g.space, ...this.pivot.position.toArray(),
       ...this.pivot.quaternion.toArray(), ...this.pivot.scale.toArray()] : [];
     const cursor = this.cursorMark.visible ? this.cursorMark.position.toArray() : [];
@@ -530,7 +533,7 @@ export class Viewer {
         return this.onRendered(); // what was asked for is on the screen already
       }
       [this.shown, this.drawAgain] = [showing, false];
-      this.renderer.render(this.scene, this.camera);
+      this.renderer.render(this.scene, this.view);
       this.lastDraw = performance.now();
       ++this.draws;
       // The full mesh's draws, timed one at a time, pace the next (a draw without it is quick).
@@ -612,9 +615,34 @@ export class Viewer {
   // Client coordinates in the camera's normalised device coordinates. The camera's matrices are
   // brought up to date first: a view key or a drag moves the camera before the next draw would.
   private ndc(clientX: number, clientY: number): THREE.Vector2 {
-    this.camera.updateMatrixWorld();
     const rect = this.canvas.getBoundingClientRect();
     return new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
+  }
+
+  // The camera that draws and picks, its matrices up to date (a view key or a drag moves the
+  // camera before the next draw would): the perspective one, or the orthographic one placed as it.
+  get view(): THREE.Camera {
+    this.camera.updateMatrixWorld();
+    if (!this.orthographic) return this.camera;
+    const o = this.ortho;
+    const half = this.camera.position.distanceTo(this.orbit.target) *
+      Math.tan(THREE.MathUtils.degToRad(this.camera.fov / 2));
+    [o.left, o.right, o.top, o.bottom] = [-half * this.camera.aspect, half * this.camera.aspect, half, -half];
+    [o.near, o.far] = [this.camera.near, this.camera.far];
+    o.position.copy(this.camera.position);
+    o.quaternion.copy(this.camera.quaternion);
+    o.updateProjectionMatrix();
+    o.updateMatrixWorld();
+    this.gizmo.camera = o;
+    return o;
+  }
+
+  // Numpad 5: perspective or orthographic; returns the new one.
+  toggleProjection(): 'orthographic' | 'perspective' {
+    this.orthographic = !this.orthographic;
+    if (!this.orthographic) this.gizmo.camera = this.camera;
+    this.requestRender();
+    return this.orthographic ? 'orthographic' : 'perspective';
   }
 
   private resize(): void {
