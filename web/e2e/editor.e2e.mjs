@@ -347,8 +347,19 @@ try {
 
     // 6: the server restarts; the page reconnects by itself and restores its edit there.
     log('server restart');
+    // A move under way (G) when the server goes: cancelled at once, nothing of it left on screen,
+    // said on reconnection.
+    const middle = await page.$eval('#view canvas', (c) => { const r = c.getBoundingClientRect(); return { x: r.left + r.width / 2, y: r.top + r.height / 2 }; });
+    const beforeMove = await snapshot();
+    await page.evaluate(() => document.activeElement?.blur());
+    await page.mouse.move(middle.x, middle.y);
+    await page.keyboard.press('g');
+    await page.mouse.move(middle.x + 60, middle.y + 20, { steps: 4 });
     editor.server.kill();
     await page.waitForSelector('#banner:not([hidden])', { timeout: 10000 });
+    check(await page.isHidden('#preview-label'), 'no "preview; detail on release" left once the server is gone');
+    check(await page.isHidden('#header'), 'no move header left once the server is gone');
+    check(JSON.stringify((await snapshot()).transforms) === JSON.stringify(beforeMove.transforms), 'the move under way was cancelled');
     const banner = await page.$eval('#banner', (b) => { const r = b.getBoundingClientRect(); return { text: b.textContent, top: r.top }; });
     check(/Disconnected/.test(banner.text) && banner.top >= 0, `a banner says the page is disconnected (${banner.text})`);
     check(await page.$eval('#export-mesh', (b) => b.disabled), 'Export is disabled while disconnected');
@@ -375,6 +386,7 @@ try {
     check(restoredError > 0.02, `and the deformation (${restoredError} of the diagonal from the rest shape)`);
     const notes = await api(() => window.specdeformEditor.notes().map((n) => n.text));
     check(notes.some((n) => /restarted/.test(n)), `the page says the server restarted (${JSON.stringify(notes)})`);
+    check(notes.some((n) => /the move \(G\) was cancelled when the connection was lost/.test(n)), 'the page says the move under way was lost');
 
     await transformsAndSelection();
 
@@ -464,6 +476,19 @@ try {
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#export-mesh')]);
     check(download.suggestedFilename() === 'cube-deformed.glb', `exported as a .glb (${download.suggestedFilename()})`);
     check(readFileSync(await download.path()).equals(readFileSync(glb)), 'the exported .glb, nothing moved, is the opened one');
+    // Move shows the gizmo at the painted handle; another mesh (a plane, nothing painted on it)
+    // opened, nothing of the cube's stays: no gizmo.
+    await page.evaluate(() => document.activeElement?.blur());
+    await page.keyboard.press('4');
+    check((await api(() => window.specdeformEditor.gizmoOnScreen())) !== null, 'Move shows the gizmo at the handle');
+    const plane = resolve(args.out, 'small-plane.obj');
+    execFileSync(args.binary, ['generate', 'bumpy-plane', '--resolution', '24', '-o', plane]);
+    await page.setInputFiles('#open-mesh', plane);
+    if (await page.$('#confirm[open]')) await page.click('#confirm-yes');
+    await page.waitForFunction(() => document.querySelector('#mesh-name').textContent.startsWith('small-plane.obj'), null, { timeout: 60000 });
+    await waitReady(30000);
+    check((await api(() => window.specdeformEditor.gizmoOnScreen())) === null, 'another mesh opened: the old one\'s gizmo is gone');
+    await page.keyboard.press('1');
     await open(writeTexturedObj(args.out), 'cube.obj: 8 vertices');
   }
 

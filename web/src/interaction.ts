@@ -62,6 +62,14 @@ export class Interaction {
 
   constructor(private readonly s: EditorState, private readonly view: HTMLElement) {
     const v = s.viewer;
+    s.onAnotherMesh = () => this.forgetMesh();
+    s.onConnectionLost = () => {
+      if (!this.drag) return null;
+      const mode = this.drag.modal?.mode;
+      const what = mode ? `the ${mode === 'grab' ? 'move' : mode === 'rotate' ? 'turn' : 'scale'} (${mode[0].toUpperCase()})` : 'the drag';
+      this.endDrag(false);
+      return what;
+    };
     // Capture phase: decides before the orbit controls what a press does.
     view.addEventListener('pointerdown', (e) => this.down(e), true);
     view.addEventListener('pointermove', (e) => this.move(e));
@@ -514,6 +522,20 @@ export class Interaction {
     if (!v.gizmo.object) return false;
     const c = v.toScreen(v.pivot.position);
     return Math.hypot(x - c.x, y - c.y) < 140;
+  }
+
+  // Another mesh is shown: nothing of the old one stays on screen (a drag, a stroke, an armed
+  // mode, the gizmo at its handle, the 3D cursor on its surface).
+  private forgetMesh(): void {
+    if (this.drag) this.endDrag(false);
+    if (this.stroke) this.endStroke(false);
+    this.endRegion(null);
+    this.linkedArmed = false;
+    this.showHeader('');
+    this.cursor = null;
+    this.s.viewer.showCursor(null);
+    this.s.viewer.gizmo.detach();
+    this.s.viewer.requestRender();
   }
 
   // Shift + right-click on the surface: the 3D cursor goes there.

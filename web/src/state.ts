@@ -284,6 +284,8 @@ export class EditorState {
   private onStatus(s: ConnectionStatus): void {
     if (s.kind === 'open') {
       if (this.phase.kind === 'disconnected') this.note('reconnected to the server');
+      if (this.lostOnDisconnect) this.note(`${this.lostOnDisconnect} was cancelled when the connection was lost: do it again`);
+      this.lostOnDisconnect = null;
       this.phase = { kind: 'connecting' };
       this.outstanding = null;
       this.restoreChecked = !this.wasOpen; // after a reconnection: does the server still have the edit?
@@ -293,6 +295,8 @@ export class EditorState {
     } else if (s.kind === 'closed') {
       // The banner stays while disconnected; the log says when it started.
       if (this.phase.kind !== 'disconnected') this.note(`disconnected: ${s.reason}`);
+      this.lostOnDisconnect ??= this.onConnectionLost();
+      this.viewer.dropPreview();
       this.phase = { kind: 'disconnected', reason: s.reason, retryAt: s.retryAt };
       this.awaitingStates = 0;
       this.selectionsInFlight = 0;
@@ -484,6 +488,13 @@ export class EditorState {
     this.pendingDraw = null;
   }
 
+  // Called as another mesh replaces the shown one (the interaction's part: interaction.ts).
+  onAnotherMesh: () => void = () => {};
+  // Called as the connection drops: ends what cannot go on without the server (a drag), naming
+  // it, to be said on reconnection.
+  onConnectionLost: () => string | null = () => null;
+  private lostOnDisconnect: string | null = null;
+
   private adoptMesh(m: P.MeshMessage): void {
     const sameTriangles = m.indices.length === this.indices.length && m.indices.every((v, i) => v === this.indices[i]);
     const samePositions = sameTriangles && m.positions.every((v, i) => v === this.rest[i]);
@@ -496,7 +507,9 @@ export class EditorState {
     if (sameTriangles && this.preview) this.postPreview(this.preview); // another pose
     if (!sameTriangles) {
       // Another mesh: the selection goes (the server says so too), the preview is measured again
-      // once it is drawn. It is painted while its basis is computed.
+      // once it is drawn. It is painted while its basis is computed. What belonged to the old one
+      // on screen (the gizmo, the 3D cursor, a drag, an armed mode) goes with it.
+      this.onAnotherMesh();
       this.indices = m.indices.slice();
       this.labels = new Int16Array(n);
       this.groups = [{ transform: new THREE.Matrix4(), pinned: false }];

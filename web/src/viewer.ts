@@ -291,6 +291,16 @@ export class Viewer {
     this.changedContent();
   }
 
+  // Back to the full mesh as its last frame left it (the coarse preview and its label gone): a
+  // drag whose frames can no longer come (the server went away).
+  dropPreview(): void {
+    if (!this.coarse.visible) return;
+    this.coarse.visible = false;
+    this.previewLabel.hidden = true;
+    this.showSurface();
+    this.changedContent();
+  }
+
   get showingPreview(): boolean {
     return this.coarse.visible;
   }
