@@ -264,6 +264,10 @@ try {
     fixed_error: fixedError,
   };
   writeFileSync(resolve(args.out, 'editor.json'), JSON.stringify(result, null, 1) + '\n');
+  if (ends.n < 50000) {
+    check(state.preview === 0 && result.previews_per_second === 0,
+      `a mesh of ${ends.n} vertices (under 50,000) is dragged whole, its look kept (preview ${state.preview})`);
+  }
   console.log(JSON.stringify(result));
   if (args['min-ratio']) {
     check(result.drawn_over_server >= Number(args['min-ratio']),
@@ -512,16 +516,22 @@ try {
     await waitReady(30000);
     await page.waitForTimeout(500); // drawn
     const at = { x: Math.round(s.x + 0.15 * (centre.x - s.x)), y: Math.round(s.y + 0.15 * (centre.y - s.y)) };
-    const shot = await page.screenshot({ clip: { ...at, width: 1, height: 1 } });
-    const [r, g, b] = await api(async (png) => {
+    const shot = await page.screenshot({ clip: { ...at, width: 12, height: 1 } });
+    const pixels = await api(async (png) => {
       const image = new Image();
       image.src = `data:image/png;base64,${png}`;
       await image.decode();
-      const canvas = new OffscreenCanvas(1, 1), context = canvas.getContext('2d');
+      const canvas = new OffscreenCanvas(image.width, 1), context = canvas.getContext('2d');
       context.drawImage(image, 0, 0);
-      return Array.from(context.getImageData(0, 0, 1, 1).data);
+      const d = Array.from(context.getImageData(0, 0, image.width, 1).data);
+      return Array.from({ length: image.width }, (_, i) => d.slice(4 * i, 4 * i + 3));
     }, shot.toString('base64'));
+    const [r, g, b] = pixels[0];
     check(r > 1.3 * g && g > 2 * b, `the painted handle shows over the texture (rgb ${r} ${g} ${b} at ${at.x}, ${at.y})`);
+    // Striped, so that it shows on a print of its own colour too: light and dark along a row.
+    const light = pixels.filter(([pr, pg, pb]) => pr > 1.3 * pg && pr > 2 * pb).map(([pr]) => pr);
+    check(light.length >= 6 && Math.max(...light) > 1.2 * Math.min(...light),
+      `the handle over the texture is striped (${JSON.stringify(pixels)})`);
   }
 
   // Typed modal transforms (exact, about the handle's centroid, the result following), cancel,

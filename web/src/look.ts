@@ -16,12 +16,15 @@ const wrapping = {
 };
 
 // The material's colour (image x base colour x vertex colour) replaced by the vertex's label
-// colour where it has one (label.a = 1).
+// colour where it has one (label.a = 1), striped (every other 5 pixels along the screen's
+// diagonal half as bright): a label stays visible on any texture, an orange handle on a tan print too.
 function drawLabels(shader: THREE.WebGLProgramParametersWithUniforms): void {
   shader.vertexShader = `attribute vec4 label;\nvarying vec4 vLabel;\n${shader.vertexShader}`.replace(
     '#include <begin_vertex>', '#include <begin_vertex>\n  vLabel = label;');
   shader.fragmentShader = `varying vec4 vLabel;\n${shader.fragmentShader}`.replace(
-    '#include <color_fragment>', '#include <color_fragment>\n  diffuseColor.rgb = mix(diffuseColor.rgb, vLabel.rgb, vLabel.a);');
+    '#include <color_fragment>', `#include <color_fragment>
+  float stripe = step(0.5, fract((gl_FragCoord.x + gl_FragCoord.y) / 10.0));
+  diffuseColor.rgb = mix(diffuseColor.rgb, vLabel.rgb * (1.0 - 0.5 * stripe), vLabel.a);`);
 }
 
 export class FileLook {

@@ -46,9 +46,12 @@ export const stats = {
 };
 
 // Draws slower than this (ms, measured once per mesh) make drags show the preview mesh, sized
-// to draw in about kPreviewMs.
+// to draw in about kPreviewMs; a mesh of fewer than kAlwaysWhole vertices never does: dragged
+// whole, with its texture and detail, on any machine that draws the page (tens of milliseconds a
+// frame without a GPU).
 const kFullDrawBudgetMs = 25;
 const kPreviewMs = 8;
+const kAlwaysWhole = 50_000;
 // A mesh's first draw slower than this is slow whatever its upload took (25 MB at a million
 // vertices: a few milliseconds on a GPU).
 const kUploadMs = 100;
@@ -571,7 +574,7 @@ export class EditorState {
     this.previewFrom = null;
     this.drawMs = ms;
     const n = this.rest.length / 3;
-    const wanted = this.drawMs > kFullDrawBudgetMs;
+    const wanted = this.drawMs > kFullDrawBudgetMs && n >= kAlwaysWhole;
     const size = Math.round(Math.max(2000, Math.min(n / 3, (n * kPreviewMs) / this.drawMs)));
     this.previewWanted = wanted;
     if (wanted && this.viewer.previewSize !== size) this.previewRequest = { type: 'preview', vertices: size };
