@@ -22,7 +22,8 @@ namespace {
 using Json = nlohmann::json;
 
 struct Strip : test::GltfModel {
-  explicit Strip(const std::vector<double>& armature_scale = {2, 2, 2}) {
+  // `hat`: a triangle mesh without a skin that joint B carries (node 4, B's child).
+  explicit Strip(const std::vector<double>& armature_scale = {2, 2, 2}, bool hat = false) {
     model.asset.version = "2.0";
     model.buffers.emplace_back();
     std::vector<float> position, target;
@@ -61,6 +62,21 @@ struct Strip : test::GltfModel {
     mesh.mesh = 0;
     mesh.skin = 0;
     model.nodes = {armature, a, b, mesh};
+    if (hat) {
+      const std::vector<float> corners = {-0.2f, 0, 0, 0.2f, 0, 0, 0, 0.3f, 0.1f};
+      tinygltf::Primitive p;
+      p.attributes = {{"POSITION", accessor(view(corners), 0, 3, TINYGLTF_TYPE_VEC3, 5126)}};
+      model.accessors.back().minValues = {-0.2, 0, 0};
+      model.accessors.back().maxValues = {0.2, 0.3, 0.1};
+      p.mode = TINYGLTF_MODE_TRIANGLES;
+      model.meshes.emplace_back();
+      model.meshes.back().primitives = {p};
+      tinygltf::Node carried;
+      carried.mesh = 1;
+      carried.translation = {0, 0.5, 0};
+      model.nodes[2].children = {4};
+      model.nodes.push_back(carried);
+    }
     std::vector<float> ibm;
     for (const Eigen::Matrix4d& world :
          {armature_world(), Eigen::Matrix4d(armature_world() * shift(1))}) {
@@ -225,6 +241,26 @@ TEST(GltfRig, AJointWhoseVerticesStayKeepsItsBytes) {
   EXPECT_EQ(kept.json["skins"], same.json["skins"]);
   EXPECT_EQ(kept.json["nodes"], same.json["nodes"]);
   EXPECT_EQ(kept.ibm(1), same.ibm(1));
+}
+
+// A mesh joint B carries without a skin (a hat) stays where it was deformed to: B moves with its
+// row, the hat's node is set back by as much, the hat's world positions are those written.
+TEST(GltfRig, AMeshAJointCarriesStaysWhereItWasDeformed) {
+  const Strip strip({2, 2, 2}, true);
+  const LoadedMesh in = read(strip);
+  ASSERT_EQ(in.file->rest.rows(), 9);  // the strip's 6, the hat's 3
+  Vertices moved = in.file->rest;
+  moved.middleRows(4, 2).rowwise() += Eigen::RowVector3d(0.4, 0, 0);  // B's row
+  moved.bottomRows(3).rowwise() += Eigen::RowVector3d(0.1, 0, 0);     // the hat, as deformed
+  const EncodedMesh out = encode_mesh_file(*in.file, moved, "out.glb");
+  const LoadedMesh back =
+      read_mesh_from_memory(out.files.at(0).bytes, MeshFormat::Glb, "back", {.keep_file = true});
+  EXPECT_LT((back.file->rest - moved).cwiseAbs().maxCoeff(), 1e-6);
+  const Written written(in, moved), same(in, in.file->rest);
+  EXPECT_NE(written.json["nodes"][2], same.json["nodes"][2]);  // B followed its row
+  EXPECT_NE(written.json["nodes"][4], same.json["nodes"][4]);  // the hat set back
+  EXPECT_NE(written.notes.back().find("(and of 1 mesh they carry, kept in place)"),
+            std::string::npos);
 }
 
 // Under an armature with unequal scales a joint's correction is no similarity: left as it was,

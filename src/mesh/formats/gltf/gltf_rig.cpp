@@ -203,18 +203,26 @@ class Follower {
       if (carried_[node] == parent) continue;
       const Eigen::Matrix4d P =
           parent_[node] >= 0 ? bind_world(parent_[node]) : Eigen::Matrix4d::Identity();
-      const Eigen::Matrix4d K = P.inverse() * parent.relative(carried_[node]).matrix() * P;
-      // Riding on its parent (the same motion, to rounding): as it was.
-      const double rounding =
-          1e-10 * (1.0 + P.topRightCorner<3, 1>().norm() + carried_[node].t.norm());
-      if ((K - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff() <= rounding) continue;
-      const Eigen::Matrix3d M = K.topLeftCorner<3, 3>();
-      if (!((M.transpose() * M - Eigen::Matrix3d::Identity()).norm() < 1e-6)) {
-        skipped_.push_back("joint " + in_["nodes"][node].value("name", std::to_string(node)) +
-                           " (under a transform with shear or unequal scales)");
+      correct(node, P.inverse() * parent.relative(carried_[node]).matrix() * P,
+              P.topRightCorner<3, 1>().norm() + carried_[node].t.norm(), "joint");
+    }
+  }
+
+  // A mesh a joint carries (a hat, a sword: a node drawing a mesh without a skin, a joint's
+  // child, no joint below it) keeps its world transform at rest: its positions were deformed
+  // where it is drawn (as a free piece, following the surface or staying, as the deformer chose).
+  // Its transforms are left-multiplied by G'^-1 G (G, G' its joint's rest world matrix before
+  // and after); it still rides on the joint in every animation.
+  void attachments() {
+    const Json& nodes = in_["nodes"];
+    for (size_t n = 0; n < parent_.size(); ++n) {
+      const int p = parent_[n];
+      if (p < 0 || !bind_.count(p) || bind_.count(int(n)) || !nodes[n].contains("mesh") ||
+          nodes[n].contains("skin") || joint_below(int(n))) {
         continue;
       }
-      correction_[node] = Rigid{nearest_rotation(M), K.topRightCorner<3, 1>()};
+      const Eigen::Matrix4d before = rest_world(p, false), after = rest_world(p, true);
+      correct(int(n), after.inverse() * before, before.topRightCorner<3, 1>().norm(), "mesh node");
     }
   }
 
@@ -341,12 +349,18 @@ class Follower {
   std::vector<std::string> notes() const {
     std::vector<std::string> out;
     if (followed_ > 0 || !correction_.empty()) {
+      const size_t joints = std::count_if(correction_.begin(), correction_.end(),
+                                          [&](const auto& c) { return bind_.count(c.first) > 0; });
+      const size_t carried = correction_.size() - joints;
       out.push_back(
           std::to_string(followed_) + " of " + std::to_string(bind_.size()) +
           " joints followed the surface they drive (their inverse bind matrices with them); the "
           "rest transforms of " +
-          counted(correction_.size(), "joint") + " and " + counted(channels_, "animation channel") +
-          " (in " + counted(animations_.size(), "animation") +
+          counted(joints, "joint") +
+          (carried > 0 ? " (and of " + counted(carried, "mesh") + " they carry, kept in place)"
+                       : std::string()) +
+          " and " + counted(channels_, "animation channel") + " (in " +
+          counted(animations_.size(), "animation") +
           ") updated, so each part turns about its joint's new place (joints \"keep\" leaves "
           "the skins as they were)");
     }
@@ -359,6 +373,41 @@ class Follower {
   }
 
  private:
+  // K kept for `node`'s transforms unless it is the identity to rounding (a node riding on its
+  // parent); named among the skipped where it is no rigid motion (shear or unequal scales above).
+  void correct(int node, const Eigen::Matrix4d& K, double scale, const char* kind) {
+    if ((K - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff() <= 1e-10 * (1.0 + scale)) return;
+    const Eigen::Matrix3d M = K.topLeftCorner<3, 3>();
+    if (!((M.transpose() * M - Eigen::Matrix3d::Identity()).norm() < 1e-6)) {
+      skipped_.push_back(std::string(kind) + " " +
+                         in_["nodes"][node].value("name", std::to_string(node)) +
+                         " (under a transform with shear or unequal scales)");
+      return;
+    }
+    correction_[node] = Rigid{nearest_rotation(M), K.topRightCorner<3, 1>()};
+  }
+
+  // A node's world matrix from the nodes' own transforms, with the corrections or without.
+  Eigen::Matrix4d rest_world(int node, bool corrected) const {
+    Eigen::Matrix4d local = node_matrix(in_["nodes"][node]);
+    if (const auto k = correction_.find(node); corrected && k != correction_.end()) {
+      local = k->second.matrix() * local;
+    }
+    return parent_[node] >= 0 ? Eigen::Matrix4d(rest_world(parent_[node], corrected) * local)
+                              : local;
+  }
+
+  bool joint_below(int node) const {
+    for (const Json& c : array_at(in_["nodes"][node], "children")) {
+      const int child = json_index(c);
+      if (child >= 0 && size_t(child) < parent_.size() &&
+          (bind_.count(child) || joint_below(child))) {
+        return true;
+      }
+    }
+    return false;
+  }
+
   // How many references the document's skins and animations make to `accessor`.
   int users(int accessor) const {
     int n = 0;
@@ -394,6 +443,7 @@ std::vector<std::string> follow_joints(GltfDocument& doc, const GltfLayout& layo
   follower.fit(layout, rest, positions);
   follower.motions();
   follower.corrections();
+  follower.attachments();
   follower.write_inverse_binds();
   follower.write_nodes();
   follower.write_animations();

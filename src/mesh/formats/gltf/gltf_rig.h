@@ -23,6 +23,9 @@
 //     becomes k_t + k_s k_R v, a rotation key q becomes k_R q, a scale key s becomes k_s s
 //     (cubic-spline tangents alike, without k_t). A joint whose K is not a similarity (a parent
 //     with shear or unequal scales) is left as it was, and said.
+//  4. A mesh a joint carries without a skin (a hat, a sword) keeps its world transform at rest (its
+//     positions were deformed where it is drawn): its transforms are left-multiplied by G'^-1 G,
+//     G and G' its joint's rest world matrix before and after; it still rides on the joint.
 // A skin that names a missing node or has fewer matrices than joints, and weights that are not
 // one per vertex, are left as they are, and said. Joints with K = I keep their bytes; so do
 // animations that key no changed joint. Accessors are written in place where they are float and
