@@ -263,6 +263,22 @@ TEST(GltfRig, AMeshAJointCarriesStaysWhereItWasDeformed) {
             std::string::npos);
 }
 
+// Nodes outside the scene whose children lists loop (a malformed file the reader takes, for the
+// scene is sound) end the walks up the parents: written, not hung.
+TEST(GltfRig, ChildrenListsThatLoopOutsideTheSceneAreCut) {
+  Strip strip;
+  tinygltf::Node a, b;
+  a.children = {5};
+  b.children = {4};
+  strip.model.nodes.push_back(a);
+  strip.model.nodes.push_back(b);
+  const LoadedMesh in = read(strip);
+  Vertices moved = in.file->rest;
+  moved.bottomRows(2).rowwise() += Eigen::RowVector3d(0.4, 0, 0);
+  const Written out(in, moved);
+  EXPECT_NE(out.notes.back().find("joints followed"), std::string::npos);
+}
+
 // Under an armature with unequal scales a joint's correction is no similarity: left as it was,
 // and said.
 TEST(GltfRig, UnequalScalesAboveAJointAreSaid) {

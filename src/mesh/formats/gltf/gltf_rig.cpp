@@ -82,6 +82,13 @@ class Follower {
         if (const int child = json_index(c); child >= 0 && size_t(child) < nodes.size()) {
           parent_[child] = int(n);
         }
+    // Children lists that loop (outside the scene, which the reader checks) are cut where they
+    // close, so that every walk up the parents ends.
+    for (size_t n = 0; n < nodes.size(); ++n) {
+      int up = int(n);
+      for (size_t steps = 0; up >= 0 && steps <= nodes.size(); ++steps) up = parent_[up];
+      if (up >= 0) parent_[n] = -1;
+    }
     for (size_t s = 0; s < array_at(in_, "skins").size(); ++s) {
       const Json& skin = in_["skins"][s];
       const int ibm =
@@ -397,14 +404,11 @@ class Follower {
                               : local;
   }
 
+  // Whether a joint has `node` among its ancestors.
   bool joint_below(int node) const {
-    for (const Json& c : array_at(in_["nodes"][node], "children")) {
-      const int child = json_index(c);
-      if (child >= 0 && size_t(child) < parent_.size() &&
-          (bind_.count(child) || joint_below(child))) {
-        return true;
-      }
-    }
+    for (const auto& [joint, B] : bind_)
+      for (int up = parent_[joint]; up >= 0; up = parent_[up])
+        if (up == node) return true;
     return false;
   }
 
