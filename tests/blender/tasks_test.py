@@ -104,7 +104,9 @@ def check_cancel_everywhere(obj, pose, diagonal):
         line = support.panel_lines(obj)[0]
         assert line.startswith("Binding again cancelled: the mesh shows its saved pose"), line
         workers_stop()
-        if cancelled[-1].startswith("basis:"):  # a basis cancelled is not cached
+        # A basis cancelled while computed is not cached. (Once a bind got past its basis, as
+        # one cancelled while posing may, the basis is saved and the next bind loads it.)
+        if cancelled[-1].startswith("basis:") and cancelled[-1] != "basis: loading the basis":
             assert not any("-m60-" in f for f in os.listdir(support.library.cache_dir()))
     for expected in ("reading the triangles", "reading the vertex groups", "basis:",
                      "building the deformer"):
