@@ -44,12 +44,24 @@ _handlers = (
     (bpy.app.handlers.load_post, handlers.bind_loaded),
     (bpy.app.handlers.undo_post, handlers.undone),
     (bpy.app.handlers.redo_post, handlers.undone),
-    (bpy.app.handlers.save_pre, handlers.finish_before_saving),
+    (bpy.app.handlers.save_pre, handlers.note_before_saving),
     (bpy.app.handlers.render_init, tasks.finish_all),
 )
 
 
+# Installed from the extension's zip as a legacy add-on (Blender 3.4's Preferences > Install, or
+# 4.2's "Install legacy Add-on"), the folder is named for the extension's id: a module "specdeform"
+# that hides the compiled one of the same name. An extension is always bl_ext.<repository>.<id>.
+WRONG_ZIP = (
+    "specdeform: this is the zip for Blender 4.2 and later (Get Extensions > Install from Disk); "
+    "for Blender 3.4-4.1, remove this add-on and install "
+    f"specdeform_blender-{'.'.join(map(str, bl_info['version']))}-blender-3.4-to-4.1.zip"
+)
+
+
 def register():
+    if __name__ == "specdeform":
+        raise RuntimeError(WRONG_ZIP)
     atexit.register(binding.shutdown)
     for cls in classes:
         bpy.utils.register_class(cls)

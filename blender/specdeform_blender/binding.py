@@ -34,6 +34,7 @@ class Binding:
     moved: float = 0.0  # time of the last update shown with displacements
     finishing: bool = False  # the timer that solves again with the full details is registered
     written: bool = False  # the mesh shows what the add-on wrote last (checked before writing)
+    keys: tuple = ()  # the names of the mesh's shape keys when last looked at
     status: dict = field(default_factory=dict)
 
 
@@ -242,6 +243,51 @@ def _check_untouched(obj, b):
         raise ChangedOutside
 
 
+def leave_pose_out_of_new_keys(obj, b):
+    """Shape keys added to a bound mesh never apply its pose twice. The first keys of a mesh bound
+    without any: Blender made the Basis of the pose shown, which is set back to the rest, and the
+    pose moves into the add-on's own key. New Shape from Mix takes every key's offset, the pose's
+    included, into the new key: a key new since the mesh was last looked at that holds the mix
+    (to float rounding) gets the pose's offset taken out again, holding the artist's keys mixed
+    over the rest; a key made otherwise (the Basis copied, a script's) is left as it is. The
+    panel says what was done (Bake Pose keeps a pose as a key)."""
+    mesh = obj.data
+    keys = mesh.shape_keys
+    names = tuple(k.name for k in keys.key_blocks) if keys is not None else ()
+    if names == b.keys:
+        return
+    known, b.keys = b.keys, names
+    if keys is None:
+        return
+    if not known:
+        keys.reference_key.data.foreach_set("co", b.rest.ravel())
+        mesh_helpers.set_coordinates(mesh, b.rest)
+        mesh_helpers.add_pose_key(obj)
+        b.keys = tuple(k.name for k in keys.key_blocks)
+        _write(obj, b)
+        b.status["note"] = ("Shape keys added while bound: the Basis is the rest shape, the pose "
+                            f"the add-on's key '{mesh_helpers.POSE_KEY}'")
+    ours = mesh_helpers.pose_key(mesh)
+    mix = mesh_helpers.relative_mix(obj)
+    if ours is None or ours.mute or mix is None:
+        return
+    offset = np.float32(ours.value) * (mesh_helpers.key_coordinates(ours)
+                                       - mesh_helpers.key_coordinates(ours.relative_key))
+    tolerance = 1e-5 * (1 + float(np.abs(mix).max()))
+    if np.abs(offset).max() <= tolerance:
+        return
+    for key in keys.key_blocks:
+        if key.name in known or key in (ours, keys.reference_key):
+            continue
+        co = mesh_helpers.key_coordinates(key)
+        if np.abs(co - mix).max() <= tolerance:
+            key.data.foreach_set("co", (co - offset).ravel())
+            mesh.update()
+            b.status["note"] = (f"New Shape from Mix: '{key.name}' holds your keys mixed over "
+                                "the rest, without the specdeform pose (Bake Pose keeps the pose "
+                                "as a key)")
+
+
 def release_changed(obj, why=None):
     """A bound mesh that no longer fits its binding, which shows a pose already: unbound, the
     shape shown kept (binding again from it would pose it twice), `why` said in the panel."""
@@ -328,8 +374,9 @@ def attach(obj, r, job, seconds, keep_shown=False):
     """Binds `obj` to the deformer `job` built (`seconds` since Bind began) and poses it (a pose
     the deformer refuses is said in the status). `keep_shown`: the mesh shows the pose of its
     targets as they were when Bind began (a file reopened, the object renamed); if they did not
-    move since, that pose stays shown until the full details are ready, rather than displacements
-    meanwhile."""
+    move since, that pose stays: as it is where it carries the full details (saved_full: the
+    file's pose bit for bit, never solved again), else until the full details are ready, rather
+    than displacements meanwhile."""
     s = obj.specdeform
     evals, evecs = job.result
     status = {"basis_s": job.basis_seconds, "bind_s": seconds,
@@ -345,8 +392,11 @@ def attach(obj, r, job, seconds, keep_shown=False):
     elif keep_shown and s.enabled and s.strength == 1.0 and np.array_equal(
             local_transforms(obj), r.transforms):
         b.positions = mesh_helpers.shown(obj.data)
-        b.last, b.exact, b.written = r.transforms, False, True
-        _finish_later_once(obj, b, 0.2)
+        b.last, b.exact, b.written = r.transforms, s.saved_full, True
+        if not b.exact:
+            _finish_later_once(obj, b, 0.2)
+    keys = obj.data.shape_keys
+    b.keys = tuple(k.name for k in keys.key_blocks) if keys is not None else ()
     _bindings[obj.name_full] = b
     notices.pop(obj.name_full, None)
     problems.pop(obj.name_full, None)

@@ -20,8 +20,9 @@ def _follow(obj, b, depsgraph):
     if len(b.rest) != len(obj.data.vertices):  # a modifier applied, Join, Separate, Decimate
         binding.release_changed(obj, f"the mesh went from {len(b.rest):,} to "
                                 f"{len(obj.data.vertices):,} vertices outside Edit Mode (a "
-                                "modifier applied, Join or Separate)")
+                                "modifier applied, Join, Separate or Decimate)")
         return
+    binding.leave_pose_out_of_new_keys(obj, b)
     if all(target for _, target, _ in binding.handles(obj)):
         try:
             binding.update(obj, b, depsgraph)
@@ -47,7 +48,10 @@ def follow_targets(scene, depsgraph):
             if obj.mode != "EDIT":
                 editing.leave(obj)
         elif binding.binding(obj) is None:
-            if obj.name_full not in binding.problems:
+            if not mesh_helpers.rest_covers(obj.data):  # Join redone, say
+                binding.release_changed(obj, "vertices were joined to the mesh outside Edit "
+                                        "Mode (Join)")
+            elif obj.name_full not in binding.problems:
                 _bind_again(obj)
         else:
             _follow(obj, binding.binding(obj), depsgraph)
@@ -116,14 +120,13 @@ def undone(*_):
 
 
 @bpy.app.handlers.persistent
-def finish_before_saving(*_):
-    """save_pre: a pose shown with its details as displacements (a quick drag, or the transfer
-    still being factored) is solved in full first, so that the file holds the pose its reopening
-    computes (the load handler solves in full)."""
+def note_before_saving(*_):
+    """save_pre: a save never solves nor waits for the transfer; the file keeps each bound mesh's
+    pose as shown, noting whether it carries the full details (saved_full). Reopened with its
+    targets where they were, a full pose is kept as saved, bit for bit; one shown with its details
+    as displacements (a quick drag, the transfer still being factored) is shown as saved and
+    solved in full in the background (binding.attach)."""
     for obj in bpy.data.objects:
         b = binding.binding(obj) if obj.type == "MESH" and obj.specdeform.bound else None
-        if b is not None and not b.exact:
-            try:
-                binding.finish(obj)
-            except library.specdeform.Error as e:
-                b.status["error"] = str(e)
+        if b is not None and obj.specdeform.saved_full != b.exact:
+            obj.specdeform.saved_full = b.exact

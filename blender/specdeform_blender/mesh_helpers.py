@@ -3,6 +3,10 @@
 import numpy as np
 
 REST = "specdeform_rest"  # the input coordinates of a bound mesh, saved with the .blend
+# Which vertices REST holds the rest of (a boolean point attribute, all true when saved): Join
+# adds vertices whose attributes Blender fills with zeros (false), which Redo gives back as a
+# bound mesh; Separate carries both attributes with its vertices.
+REST_SET = "specdeform_rest_set"
 
 
 def coordinates(mesh):
@@ -38,6 +42,29 @@ def add_pose_key(obj):
     key.relative_key = mesh.shape_keys.reference_key
     key.value = 1.0
     obj.active_shape_key_index = active
+
+
+def key_coordinates(key):
+    co = np.empty(3 * len(key.data), np.float32)
+    key.data.foreach_get("co", co)
+    return co.reshape(-1, 3)
+
+
+def relative_mix(obj):
+    """The shape Blender mixes from the mesh's relative shape keys, as New Shape from Mix takes
+    it: the basis plus each unmuted key's value times its offset from its relative key; None
+    where Blender mixes otherwise (absolute keys, a key limited to a vertex group, a key shown
+    alone)."""
+    keys = obj.data.shape_keys
+    blocks = list(keys.key_blocks)
+    if not keys.use_relative or obj.show_only_shape_key or any(k.vertex_group for k in blocks):
+        return None
+    co = {k.name: key_coordinates(k) for k in blocks}
+    mix = co[keys.reference_key.name].copy()
+    for k in blocks[1:]:
+        if not k.mute and k.value != 0:
+            mix += np.float32(k.value) * (co[k.name] - co[k.relative_key.name])
+    return mix
 
 
 def rest_coordinates(mesh):
@@ -79,12 +106,17 @@ def restore(obj, rest):
         set_coordinates(obj.data, rest)
 
 
-def triangles(mesh):
-    """The mesh's faces triangulated (Blender's loop triangles): vertex indices (f, 3)."""
-    mesh.calc_loop_triangles()
-    tris = np.empty(3 * len(mesh.loop_triangles), np.int32)
-    mesh.loop_triangles.foreach_get("vertices", tris)
-    return tris.reshape(-1, 3)
+def polygons(mesh):
+    """The mesh's faces: the corners of each (int32 (p,)) and their vertices, face after face
+    (int32 (sum,)); triangulation.triangulate makes triangles of them."""
+    sizes = np.empty(len(mesh.polygons), np.int32)
+    mesh.polygons.foreach_get("loop_total", sizes)
+    starts = np.empty(len(mesh.polygons), np.int32)
+    mesh.polygons.foreach_get("loop_start", starts)
+    loops = np.empty(len(mesh.loops), np.int32)
+    mesh.loops.foreach_get("vertex_index", loops)
+    within = np.arange(sizes.sum()) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+    return sizes, loops[np.repeat(starts, sizes) + within]
 
 
 def add_group_weights(vertices, index, found):
@@ -101,6 +133,18 @@ def add_group_weights(vertices, index, found):
 def save_rest(mesh, co):
     attribute = mesh.attributes.get(REST) or mesh.attributes.new(REST, "FLOAT_VECTOR", "POINT")
     attribute.data.foreach_set("vector", np.ascontiguousarray(co, np.float32).ravel())
+    flags = mesh.attributes.get(REST_SET) or mesh.attributes.new(REST_SET, "BOOLEAN", "POINT")
+    flags.data.foreach_set("value", np.ones(len(co), bool))
+
+
+def rest_covers(mesh):
+    """Whether the saved rest holds every vertex's (false: vertices joined since it was saved)."""
+    flags = mesh.attributes.get(REST_SET)
+    if flags is None:  # saved before the flags were
+        return True
+    values = np.empty(len(flags.data), bool)
+    flags.data.foreach_get("value", values)
+    return bool(values.all())
 
 
 def saved_rest(mesh):
@@ -113,6 +157,7 @@ def saved_rest(mesh):
 
 
 def drop_rest(mesh):
-    attribute = mesh.attributes.get(REST)
-    if attribute is not None:
-        mesh.attributes.remove(attribute)
+    for name in (REST, REST_SET):
+        attribute = mesh.attributes.get(name)
+        if attribute is not None:
+            mesh.attributes.remove(attribute)

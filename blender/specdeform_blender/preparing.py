@@ -1,10 +1,11 @@
 """Bind's pipeline in steps, so that Bind, a file reopened and Edit Mode left never hold the
-window: Blender's main thread does what only it may (the settings and the rest, the triangles,
-the vertex groups chunk by chunk, then attaching the deformer to the object: each step at most a
-few tenths of a second at 692k vertices), and a worker thread the rest (the mesh renumbered, the
-basis computed or loaded from the cache, the selection checked, the deformer built). `steps()`
-is a generator that yields between the main thread's steps; a timer drives it in a window
-(tasks.py), `bind_now()` at once (scripts, `blender -b`, renders)."""
+window: Blender's main thread does what only it may (the settings, the rest and the faces in a
+few bulk reads, the vertex groups' weights in steps of at most STEP_S whatever else runs on the
+machine, then attaching the deformer to the object), and a worker thread the rest (the faces
+triangulated, the mesh renumbered, the basis computed or loaded from the cache, the selection
+checked, the deformer built). `steps()` is a generator that yields between the main thread's
+steps; a timer drives it in a window (tasks.py), `bind_now()` at once (scripts, `blender -b`,
+renders)."""
 
 import os
 import threading
@@ -13,14 +14,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import binding, library, mesh_helpers
+from . import binding, library, mesh_helpers, triangulation
 
-GROUP_CHUNK = 100_000  # vertices whose vertex groups one step reads (0.17 s at 692k)
-# Triangles: up to TRIANGLES_AT_ONCE read in one step by foreach_get (0.63 s for 1.38M headless,
-# up to 1.07 s in a window: Blender 3.4 has no faster read of a mesh's faces); more a chunk a step
-# (0.15 s each, 3 times foreach_get's total time).
-TRIANGLES_AT_ONCE = 300_000
-TRIANGLE_CHUNK = 50_000
+# The main thread's steps end once they have run this long: the vertex groups are read a chunk at
+# a time (a Python loop: Blender 3.4 has no bulk access to them), chunks sized by the time the
+# last one took.
+STEP_S = 0.1
+GROUP_CHUNK = 4_000  # the first chunk of vertices (about 7 ms idle); then a quarter step each
 CANCELLED = "bind: cancelled"
 CHANGED = "Object Data: the mesh changed while it was being bound; press Bind again"
 
@@ -31,7 +31,7 @@ class Request:
     groups), and what the worker thread makes of it in the deformer's numbering."""
 
     rest: np.ndarray  # float32 (n, 3), every vertex
-    triangles: np.ndarray  # int32 (f, 3), Blender's numbering
+    faces: tuple  # mesh_helpers.polygons: the corners of each face and their vertices
     modes: int
     eigensolver: str
     options: dict  # the deformer's keywords
@@ -41,6 +41,7 @@ class Request:
     transforms: np.ndarray  # the targets' (binding.local_transforms) as Bind began
     weights: dict = None  # name -> (vertex indices, weights), Blender's numbering
     # Made by the worker thread:
+    triangles: np.ndarray = None  # int32 (f, 3), Blender's numbering
     used: np.ndarray = None  # the vertices the faces use
     renumber: np.ndarray = None  # each vertex's index in the deformer's numbering (-1: in no face)
     V: np.ndarray = None  # float64 (m, 3): the used vertices' rest
@@ -51,9 +52,9 @@ class Request:
 
 
 def request(obj):
-    """Bind's settings, rest and targets from `obj` (its saved rest when it is bound already; on
-    a first Bind the targets are held as they are now, binding.hold_targets), or an error
-    message; the triangles and the vertex groups are read by the next steps."""
+    """Bind's settings, rest, faces and targets from `obj` (its saved rest when it is bound
+    already; on a first Bind the targets are held as they are now, binding.hold_targets), or an
+    error message; the vertex groups are read by the next steps."""
     s = obj.specdeform
     problem = binding.check(obj)
     if problem:
@@ -64,7 +65,7 @@ def request(obj):
                "constraint_weight": s.constraint_weight}
     if not s.bound:
         binding.hold_targets(obj)
-    return Request(rest, None, s.modes, s.eigensolver, options, names,
+    return Request(rest, mesh_helpers.polygons(obj.data), s.modes, s.eigensolver, options, names,
                    binding.fields(obj)[:len(names)], bool(s.fixed_group),
                    binding.local_transforms(obj))
 
@@ -77,42 +78,32 @@ def _rest(obj):
 
 
 def _group_weights(obj, names):
-    """Generator: the weights of the vertex groups `names` (mesh_helpers.add_group_weights),
-    GROUP_CHUNK vertices a step; each resumption passes the object again (an undo replaces it).
+    """Generator: the weights of the vertex groups `names` (mesh_helpers.add_group_weights), in
+    steps of about STEP_S; each resumption passes the object again (an undo replaces it).
     Returns the object as last passed and the weights, or an error message."""
     n = len(obj.data.vertices)
     index = {obj.vertex_groups[name].index: name for name in names}
     found = {name: ([], []) for name in names}
-    for start in range(0, n, GROUP_CHUNK):
+    start, chunk = 0, GROUP_CHUNK
+    while start < n:
         if len(obj.data.vertices) != n:
             return obj, CHANGED
-        mesh_helpers.add_group_weights(obj.data.vertices[start:start + GROUP_CHUNK], index, found)
-        obj = yield "reading the vertex groups", min(n, start + GROUP_CHUNK) / n
+        began = time.perf_counter()
+        while start < n and time.perf_counter() - began < STEP_S:
+            stop = min(n, start + chunk)
+            chunk_began = time.perf_counter()
+            mesh_helpers.add_group_weights(obj.data.vertices[start:stop], index, found)
+            per_vertex = (time.perf_counter() - chunk_began) / (stop - start)
+            chunk = max(100, int(0.25 * STEP_S / max(per_vertex, 1e-9)))  # a quarter step
+            start = stop
+        obj = yield "reading the vertex groups", start / n
     return obj, {name: (np.array(i, np.int64), np.array(w)) for name, (i, w) in found.items()}
-
-
-def _triangles(obj, at_once):
-    """Generator: mesh_helpers.triangles, a chunk a step on a large mesh unless `at_once`.
-    Returns the object as last passed and the triangles, or an error message."""
-    mesh = obj.data
-    mesh.calc_loop_triangles()
-    n = len(mesh.loop_triangles)
-    if at_once or n <= TRIANGLES_AT_ONCE:
-        return obj, mesh_helpers.triangles(mesh)
-    out = np.empty((n, 3), np.int32)
-    for start in range(0, n, TRIANGLE_CHUNK):
-        chunk = mesh.loop_triangles[start:start + TRIANGLE_CHUNK]
-        out[start:start + len(chunk)] = [t.vertices[:] for t in chunk]
-        obj = yield "reading the triangles", min(n, start + TRIANGLE_CHUNK) / n
-        mesh = obj.data
-        if len(mesh.loop_triangles) != n:
-            return obj, CHANGED
-    return obj, out
 
 
 def _renumber(r):
     """The deformer's numbering: the vertices the faces use (loose ones stay put); an error
     message, or None."""
+    r.triangles = triangulation.triangulate(*r.faces, r.rest)
     used = np.flatnonzero(np.bincount(r.triangles.ravel(), minlength=len(r.rest)))
     if r.modes > len(used):
         return f"Modes is {r.modes}, more than the mesh's {len(used)} vertices: lower Modes"
@@ -254,25 +245,17 @@ class BindJob:
         return text
 
 
-def steps(obj, keep_shown=False, at_once=False):
+def steps(obj, keep_shown=False):
     """Bind's pipeline as a generator. Each `yield` ends a main-thread step with what is being
     done (the stage and the fraction done) or the job being waited for; the driver resumes it
     with the object looked up again (`send(obj)`) and closes it to cancel. keep_shown: see
-    binding.attach; at_once: no chunks where they cost time (nothing waits for the thread).
-    Returns an error message, or None."""
+    binding.attach. Returns an error message, or None."""
     started = time.perf_counter()
     r = request(obj)
     if isinstance(r, str):
         return r
-    obj = yield "reading the triangles", 0.0
-    obj, triangles = yield from _triangles(obj, at_once)
-    if isinstance(triangles, str):
-        return triangles
-    if len(triangles) == 0:
+    if len(r.faces[0]) == 0:
         return "Object Data: the mesh has no faces"
-    r.triangles = triangles
-    if len(obj.data.vertices) != len(r.rest):
-        return CHANGED
     job = BindJob(r, len(binding.handles(obj)))
     try:
         obj = yield "reading the vertex groups", 0.0
@@ -297,7 +280,7 @@ def steps(obj, keep_shown=False, at_once=False):
 def bind_now(obj, report=None, keep_shown=False):
     """Bind's whole pipeline at once (scripts, `blender -b`, renders); report(text) is called
     every second while the worker runs. Returns an error message, or None."""
-    pipeline = steps(obj, keep_shown, at_once=True)
+    pipeline = steps(obj, keep_shown)
     try:
         waiting = next(pipeline)
         while True:

@@ -91,7 +91,7 @@ class SpecdeformSettings(bpy.types.PropertyGroup):
         default="transfer",
     )
     unconstrained: EnumProperty(
-        name="Free pieces",
+        name="Loose parts",
         description="Loose parts without a handle or fixed vertex",
         items=(
             ("follow", "Follow", "Move rigidly with the deformed surface around them"),
@@ -100,8 +100,10 @@ class SpecdeformSettings(bpy.types.PropertyGroup):
         default="follow",
     )
     constraint_weight: FloatProperty(
-        name="Weight",
-        description="Soft constraint weight (on the mesh scaled to unit area)",
+        name="Constraint weight",
+        description="How firmly the handles reach their targets and the fixed vertices stay: "
+        "soft constraints, weighed against the surface's energy on the mesh scaled to unit area "
+        "(higher: closer; the default holds them to about 1e-5 of the mesh's size)",
         default=1e5,
         min=1e-6,
     )
@@ -129,3 +131,8 @@ class SpecdeformSettings(bpy.types.PropertyGroup):
         update=_retag,
     )
     bound: BoolProperty(name="Bound", description="The mesh follows the target", default=False)
+    saved_full: BoolProperty(
+        name="Saved in full",
+        description="The pose saved in the file carries the full details (not displacements)",
+        default=True,
+    )

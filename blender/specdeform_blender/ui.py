@@ -1,25 +1,52 @@
 """The sidebar (N) panel: handles, fixed group, settings, Bind / Unbind / Apply, Bake, timings and
 status."""
 
-import textwrap
-
+import blf
 import bpy
 
 from . import binding, library, tasks
 
-# Average width of a character of the panel's text, in pixels at UI scale 1 (Blender's default
-# font at its default size), and the panel's margins.
-CHAR_PX = 6.5
-MARGIN_PX = 40
+HANDLES_LABEL = "More handles: a vertex group and its target per row"
+WEIGHT_LABEL = ("Constraint weight: how firmly the handles reach their targets and the fixed "
+                "vertices stay (higher: closer)")
+# The room a label loses in the sidebar, in pixels at UI scale 1: the panel's margins and the
+# sidebar's column of tabs (measured: a 229-pixel sidebar leaves 173 to its labels); an icon.
+MARGIN_PX = 56
+ICON_PX = 22
+
+
+def interface_scale(context):
+    """Blender's interface scale (U.dpi_fac): the system's pixel size times its DPI over 72 (the
+    DPI includes the UI scale and the display's own)."""
+    system = context.preferences.system
+    return system.pixel_size * system.dpi / 72
+
+
+def text_px(context, text):
+    """The width of `text` in the panel's font (Blender's widget style, blf), in pixels."""
+    blf.size(0, context.preferences.ui_styles[0].widget.points * interface_scale(context))
+    return blf.dimensions(0, text)[0]
+
+
+def wrap(context, text, room):
+    """`text` in lines no wider than `room` pixels, measured in the panel's font (a word wider
+    than that is a line of its own)."""
+    lines = []
+    for word in text.split():
+        if lines and text_px(context, f"{lines[-1]} {word}") <= room:
+            lines[-1] += f" {word}"
+        else:
+            lines.append(word)
+    return lines or [""]
 
 
 def _say(context, layout, text, icon="NONE"):
-    """`text` wrapped at the sidebar's width (the first line with the icon): no line is cut off
-    with "..." however narrow the sidebar."""
+    """`text` wrapped at the sidebar's width (the first line with the icon, the others indented
+    by as much): no line is cut off with "..." however narrow the sidebar."""
     width = context.region.width if context.region else 300
-    chars = max(16, int((width - MARGIN_PX) / (CHAR_PX * context.preferences.view.ui_scale)))
+    room = width - interface_scale(context) * (MARGIN_PX + (ICON_PX if icon != "NONE" else 0))
     column = layout.column(align=True)
-    for i, line in enumerate(textwrap.wrap(text, chars) or [""]):
+    for i, line in enumerate(wrap(context, text, room)):
         column.label(text=line, icon=icon if i == 0 else "BLANK1" if icon != "NONE" else "NONE")
 
 
@@ -81,6 +108,7 @@ class VIEW3D_PT_specdeform(bpy.types.Panel):
         col.enabled = not s.bound
         col.prop_search(s, "handle_group", obj, "vertex_groups")
         col.prop(s, "target")
+        _say(context, col, HANDLES_LABEL)
         row = col.row()
         row.template_list("SPECDEFORM_UL_handles", "", s, "handles", s, "handle_index", rows=2)
         buttons = row.column(align=True)
@@ -91,8 +119,9 @@ class VIEW3D_PT_specdeform(bpy.types.Panel):
         col.prop(s, "eigensolver")
         col.prop(s, "energy")
         col.prop(s, "detail")
-        col.prop(s, "unconstrained", text="Free")
-        col.prop(s, "constraint_weight")
+        col.prop(s, "unconstrained", text="Loose")
+        col.prop(s, "constraint_weight", text="Weight")
+        _say(context, col, WEIGHT_LABEL)
         layout.prop(s, "quick_drags")
         layout.prop(s, "enabled")
         layout.prop(s, "strength", slider=True)

@@ -282,6 +282,58 @@ def check_shape_keys():
     assert np.abs(support.evaluated(obj) - co).max() <= 1e-6, "unbind: the basis and the key"
 
 
+def check_keys_while_bound():
+    """Shape keys added to a bound mesh never pose it twice: the first key (the Basis, which
+    Blender makes of the pose shown) is set back to the rest and the pose moves into the add-on's
+    key, the mesh still following; New Shape from Mix takes the artist's keys mixed over the rest,
+    without the pose (the panel saying so both times)."""
+    V, F = specdeform.bumpy_bar(cells_per_unit=6)
+    handle, fixed = np.flatnonzero(V[:, 0] > 3.6), np.flatnonzero(V[:, 0] < 0.4)
+    obj, empty = support.add_object("keys-added", V, F, handle, fixed)
+    rest = support.evaluated(obj)
+    tolerance = 1e-5 * support.diagonal(rest)
+    support.bind(obj)
+    T = np.eye(4)
+    T[:3, 3] = (0, 0.5, 0.3)
+    support.move(empty, T)
+    pose = support.evaluated(obj)
+    bpy.ops.object.shape_key_add(from_mix=False)  # the panel's +: the Basis, of the pose shown
+    bpy.context.view_layer.update()
+    keys = obj.data.shape_keys.key_blocks
+    assert [k.name for k in keys] == ["Basis", "specdeform"], [k.name for k in keys]
+    assert np.abs(support.mesh_helpers.key_coordinates(keys["Basis"]) - rest).max() <= 1e-6
+    assert np.abs(support.evaluated(obj) - pose).max() <= tolerance, "the pose shown changed"
+    note = support.binding.binding(obj).status["note"]
+    print(f"first key added while bound: {note}")
+    T2 = T.copy()
+    T2[:3, 3] = (0, -0.4, 0.2)
+    support.move(empty, T2)
+    miss = np.abs(support.evaluated(obj)[handle] - support.apply_transform(T2, rest[handle]))
+    assert miss.max() <= 0.005 * support.diagonal(rest), "no longer follows"
+    pose = support.evaluated(obj)
+
+    bulge = obj.shape_key_add(name="bulge", from_mix=False)
+    middle = np.flatnonzero(np.abs(V[:, 0] - 2) < 0.3)
+    co = rest.copy()
+    co[middle, 2] += 0.2
+    bulge.data.foreach_set("co", co.ravel())
+    bulge.value = 0.5
+    bpy.context.view_layer.update()
+    obj.active_shape_key_index = 0
+    bpy.ops.object.shape_key_add(from_mix=True)  # Shape Key Specials > New Shape from Mix
+    bpy.context.view_layer.update()
+    mixed = obj.data.shape_keys.key_blocks[-1]
+    taken = support.mesh_helpers.key_coordinates(mixed)
+    miss = np.abs(taken - (rest + 0.5 * (co - rest))).max() / support.diagonal(rest)
+    print(f"New Shape from Mix: '{mixed.name}' {miss:.1e} of the diagonal from the keys' mix "
+          f"over the rest; {support.binding.binding(obj).status['note']}")
+    assert miss <= 1e-6, "the pose captured in the new key"
+    mixed.value, bulge.value = 1.0, 0.0
+    bpy.context.view_layer.update()
+    shown = support.evaluated(obj)
+    assert np.abs(shown - (pose + 0.5 * (co - rest))).max() <= tolerance, "posed twice"
+
+
 def check_modifier_apply():
     """Applying a Subdivision Surface while posed: the subdivided pose stays (unbound, said in one
     line), never the pose applied twice; moving the target back changes nothing. A Smooth
@@ -422,8 +474,9 @@ def check_loose_parts():
         assert line.endswith("100 asked, more as each of 2 loose parts gets its own"), line
         # A narrow sidebar: the same words, wrapped, no line wider than the sidebar.
         narrow = support.panel_lines(obj, width=200)
-        chars = (200 - ui.MARGIN_PX) / (ui.CHAR_PX * bpy.context.preferences.view.ui_scale)
-        assert all(len(x) <= chars for x in narrow) and len(narrow) > len(support.panel_lines(obj))
+        widest = max(ui.text_px(bpy.context, x) for x in narrow)
+        room = 200 - ui.MARGIN_PX * ui.interface_scale(bpy.context)
+        assert widest <= room and len(narrow) > len(support.panel_lines(obj)), narrow
         assert " ".join(support.panel_lines(obj)) == " ".join(narrow), narrow
         support.move(empty, T)
         X = support.evaluated(obj)
@@ -450,6 +503,7 @@ def main():
             check_modifier_apply()
             check_join_separate()
             check_shape_keys()
+            check_keys_while_bound()
     print("passed")
 
 

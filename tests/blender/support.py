@@ -110,11 +110,16 @@ class Layout:
     def prop(self, *_, **__):
         pass
 
-    prop_search = operator = template_list = prop
+    prop_search = template_list = prop
+
+    def operator(self, *_, **__):
+        """The status lines follow the panel's last button: the labels before it are dropped."""
+        self.labels.clear()
 
 
 def panel_lines(obj, width=100000):
-    """The lines of text the sidebar panel shows for `obj` in a sidebar `width` pixels wide."""
+    """The status lines the sidebar panel shows for `obj` in a sidebar `width` pixels wide (the
+    lines below its buttons)."""
     from specdeform_blender import ui
 
     panel = type("Panel", (), {"layout": Layout()})()

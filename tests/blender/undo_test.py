@@ -2,7 +2,7 @@
 and a step pushed after each other change, as the window does after each action of the user.
 Every state undone or redone to shows the mesh as it was then, and where it is bound, a binding
 that fits it: moving the target poses it from its own rest, never from a pose (a pose applied
-twice). Target moves, Bind, Unbind, Strength, a modifier applied, and Edit Mode's edits.
+twice). Target moves, Bind, Unbind, Strength, a modifier applied, Edit Mode's edits, and Join.
 
     blender -b --factory-startup --python-exit-code 1 --python undo_test.py
 Environment: SPECDEFORM_BLENDER_DIR, SPECDEFORM_PYTHON_DIR. Exits 1 on a failed check.
@@ -193,7 +193,44 @@ def main():
     state(*walk[1])
     bpy.ops.object.mode_set(mode="OBJECT")  # the edit undone: the bar as it was
     fits(poses, "Edit Mode left, its edit undone")
+    push("back at 0.8")
+    check_join(V, poses)
     print("passed")
+
+
+def check_join(V, poses):
+    """Join with the bound bar active unbinds it, keeping the joined shape; undone, the bar is
+    bound and fits; redone, the joined mesh is unbound again with one line saying why, never
+    bound to a rest that Join filled with zeros for the cube's vertices (the flags beside the
+    rest, false for them, say it)."""
+    support.move(objects()[1], shift(0.8))
+    posed = shown()
+    bpy.ops.mesh.primitive_cube_add(location=(2, 3, 0))
+    cube = bpy.context.object
+    push("cube added")
+    bpy.ops.object.select_all(action="DESELECT")
+    obj = objects()[0]
+    obj.select_set(True), cube.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+    assert bpy.ops.object.join("EXEC_DEFAULT", True) == {"FINISHED"}
+    bpy.context.view_layer.update()
+    joined = shown()
+    assert len(joined) == len(V) + 8 and not objects()[0].specdeform.bound
+    same(joined[:len(V)], posed, "joined: the bar's pose kept")
+    undo()
+    assert objects()[0].specdeform.bound and len(shown()) == len(V), "Join undone"
+    same(shown(), posed, "Join undone")
+    fits(poses, "Join undone")
+    support.move(objects()[1], shift(0.8))
+    undo(redo=True)
+    obj = objects()[0]
+    assert len(obj.data.vertices) == len(V) + 8, "Join redone"
+    assert not obj.specdeform.bound, "Join redone: bound to a rest that does not fit"
+    assert obj.name_full not in support.binding.problems, support.binding.problems
+    notice = support.binding.notices[obj.name_full]
+    print(f"Join redone: {notice}")
+    assert "joined" in notice and notice.endswith("Bind to deform it again"), notice
+    same(shown(), joined, "Join redone: the joined shape kept")
 
 
 with tempfile.TemporaryDirectory() as cache:

@@ -1,6 +1,7 @@
 """The add-on's zip installed the way users do (Preferences > Install, then enable) into a fresh
 user scripts folder (BLENDER_USER_SCRIPTS), its bundled module loaded from there, and a mesh bound
-and moved.
+and moved. Given the extension's zip (Blender 4.2+), Blender 3.4's Install puts it in one folder
+and enabling it is refused with one line naming the zip for this Blender.
 
     BLENDER_USER_SCRIPTS=DIR blender -b --factory-startup --python-exit-code 1 \\
         --python zip_test.py -- ZIP
@@ -16,7 +17,16 @@ import numpy as np
 zip_path = sys.argv[sys.argv.index("--") + 1]
 user_addons = bpy.utils.user_resource("SCRIPTS", path="addons")
 assert user_addons.startswith(os.environ["BLENDER_USER_SCRIPTS"]), user_addons
+before = set(os.listdir(user_addons)) if os.path.isdir(user_addons) else set()
 assert bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True) == {"FINISHED"}
+if "4.2-and-later" in os.path.basename(zip_path):
+    assert set(os.listdir(user_addons)) - before <= {"specdeform"}, os.listdir(user_addons)
+    errors = []
+    assert addon_utils.enable("specdeform", handle_error=errors.append) is None
+    assert "specdeform" not in bpy.context.preferences.addons
+    print(f"refused: {errors[0]}")
+    assert "for Blender 3.4-4.1" in str(errors[0]) and "-blender-3.4-to-4.1.zip" in str(errors[0])
+    sys.exit(0)
 addon_utils.enable("specdeform_blender", default_set=True, handle_error=None)
 library = sys.modules["specdeform_blender.library"]
 assert library.specdeform is not None, library.problem

@@ -1,10 +1,11 @@
-"""The add-on's two zips as an artist gets them (issues 45, 55): the add-on for Blender 3.4-4.1
-(its folder at the top) and the extension for Blender 4.2+ (blender_manifest.toml at the top)
-carry the same files; every compiled file in them needs only what they carry or glibc,
-libstdc++, libgcc and libm, and each library they carry has its licence beside it, the project's
-LICENSE at the top; the manifest holds to Blender's documented schema (version 1.0.0, as Blender's own
-`extension validate` checks it); the add-on imports its own modules relatively, as an extension
-must (it is loaded as bl_ext.<repository>.specdeform).
+"""The add-on's two zips as an artist gets them (issues 45, 55, 57): the add-on for Blender 3.4-4.1
+(its folder specdeform_blender at the top) and the extension for Blender 4.2+ (one folder named
+for its id, blender_manifest.toml in it: Blender 4.2 takes one folder holding the manifest), each
+named for its Blenders, carry the same files; every compiled file in them needs only what they
+carry or glibc, libstdc++, libgcc and libm, and each library they carry has its licence beside
+it, the project's LICENSE at the top; the manifest holds to Blender's documented schema (version
+1.0.0, as Blender's own `extension validate` checks it); the add-on imports its own modules
+relatively, as an extension must (it is loaded as bl_ext.<repository>.specdeform).
 
     /usr/bin/python3 addon_package_test.py ADDON_ZIP EXTENSION_ZIP BUNDLE_LIBS_PY VERSION
 """
@@ -23,9 +24,12 @@ work = Path(tempfile.mkdtemp())
 zipfile.ZipFile(addon_zip).extractall(work / "addon")
 zipfile.ZipFile(extension_zip).extractall(work / "extension")
 addon = work / "addon" / "specdeform_blender"
-extension = work / "extension"
 
+assert Path(addon_zip).name == f"specdeform_blender-{version}-blender-3.4-to-4.1.zip"
+assert Path(extension_zip).name == f"specdeform-{version}-blender-4.2-and-later-linux_x64.zip"
 assert [p.name for p in (work / "addon").iterdir()] == ["specdeform_blender"]
+assert [p.name for p in (work / "extension").iterdir()] == ["specdeform"]
+extension = work / "extension" / "specdeform"
 files = sorted(str(p.relative_to(addon)) for p in addon.rglob("*") if p.is_file())
 assert files == sorted(str(p.relative_to(extension)) for p in extension.rglob("*") if p.is_file())
 assert "blender_manifest.toml" in files and "__init__.py" in files, files
@@ -50,6 +54,7 @@ for key, value in manifest.items():
     assert isinstance(value, (required | optional)[key]), f"manifest: {key} is a {type(value)}"
 assert manifest["schema_version"] == "1.0.0"
 assert manifest["id"].isidentifier() and not manifest["id"].startswith("_"), manifest["id"]
+assert manifest["id"] == extension.name, "the folder is named for the id (__init__.py's check)"
 assert manifest["version"] == version, (manifest["version"], version)
 
 
