@@ -226,6 +226,17 @@ def check_strength(obj):
     assert bpy.ops.specdeform.apply() == {"FINISHED"}
 
 
+def add_bulge(obj, rest, value):
+    """A shape key "bulge" raising the bar's middle by 0.2, at `value`: (key, middle, its co)."""
+    bulge = obj.shape_key_add(name="bulge", from_mix=False)
+    middle = np.flatnonzero(np.abs(rest[:, 0] - 2) < 0.3)
+    co = rest.copy()
+    co[middle, 2] += 0.2
+    bulge.data.foreach_set("co", co.ravel())
+    bulge.value = value
+    return bulge, middle, co
+
+
 def check_shape_keys():
     """A mesh with a shape key binds; the pose lives in a key of its own, so the artist's key
     still moves its vertices on top of it; Strength mixes rest and pose; Unbind removes the key."""
@@ -235,12 +246,7 @@ def check_shape_keys():
     rest = support.evaluated(obj)
     tolerance = 1e-5 * support.diagonal(rest)
     obj.shape_key_add(name="Basis", from_mix=False)
-    bulge = obj.shape_key_add(name="bulge", from_mix=False)
-    middle = np.flatnonzero(np.abs(V[:, 0] - 2) < 0.3)
-    co = rest.copy()
-    co[middle, 2] += 0.2
-    bulge.data.foreach_set("co", co.ravel())
-    bulge.value = 1.0
+    bulge, middle, co = add_bulge(obj, rest, 1.0)
     support.bind(obj)
     assert np.abs(support.evaluated(obj) - co).max() <= tolerance, "binding moved the mesh"
     T = np.eye(4)
@@ -312,12 +318,7 @@ def check_keys_while_bound():
     assert miss.max() <= 0.005 * support.diagonal(rest), "no longer follows"
     pose = support.evaluated(obj)
 
-    bulge = obj.shape_key_add(name="bulge", from_mix=False)
-    middle = np.flatnonzero(np.abs(V[:, 0] - 2) < 0.3)
-    co = rest.copy()
-    co[middle, 2] += 0.2
-    bulge.data.foreach_set("co", co.ravel())
-    bulge.value = 0.5
+    bulge, _, co = add_bulge(obj, rest, 0.5)
     bpy.context.view_layer.update()
     obj.active_shape_key_index = 0
     bpy.ops.object.shape_key_add(from_mix=True)  # Shape Key Specials > New Shape from Mix
