@@ -1,6 +1,15 @@
 #include "parallel.h"
 
+#include <cerrno>
 #include <chrono>
+#include <map>
+#include <memory>
+
+#if defined(__linux__)
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
 
 namespace specdeform::detail {
 
@@ -10,11 +19,27 @@ namespace {
 // come a few hundred microseconds apart, and waking a sleeping thread costs tens of them.
 constexpr auto kPoll = std::chrono::microseconds(300);
 
+// The calling thread's nice value (0 where threads have no priority of their own).
+int thread_nice() {
+#if defined(__linux__)
+  errno = 0;
+  const int nice = getpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)));
+  return errno == 0 ? nice : 0;
+#else
+  return 0;
+#endif
+}
+
 }  // namespace
 
 HelperThread& HelperThread::instance() {
-  static HelperThread helper;
-  return helper;
+  static std::mutex mutex;
+  static std::map<int, std::unique_ptr<HelperThread>> helpers;  // by nice value
+  const int nice = thread_nice();
+  std::lock_guard lock(mutex);
+  std::unique_ptr<HelperThread>& helper = helpers[nice];
+  if (!helper) helper.reset(new HelperThread());  // started here: it inherits this priority
+  return *helper;
 }
 
 HelperThread::HelperThread() : thread_([this] { loop(); }) {}

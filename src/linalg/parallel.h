@@ -3,9 +3,12 @@
 // A helper thread is kept for them: starting a thread costs about 50 us, a frame's loop about
 // 500 us. Between jobs it polls (yielding) for a short while, then sleeps. It runs one job at a
 // time; a caller that finds it busy (another deformer on another
-// thread) starts a thread of its own. Either way the two halves run at the same time, so they
-// may synchronise with each other (a std::barrier). HelperThread's jobs must not throw;
-// run_pair and split_in_two carry their functions' exceptions back to the caller.
+// thread) starts a thread of its own. There is one helper per scheduling priority (Linux's nice
+// value, a thread's own, which the threads it starts inherit): a background thread that lowered
+// its priority (the transfer's factorisation) is helped at its priority, and a caller at the
+// normal one never waits for a helper that a busy machine starves. Either way the two halves run at
+// the same time, so they may synchronise with each other (a std::barrier). HelperThread's jobs must
+// not throw; run_pair and split_in_two carry their functions' exceptions back to the caller.
 #pragma once
 
 #include <atomic>
@@ -21,6 +24,7 @@ namespace specdeform::detail {
 
 class HelperThread {
  public:
+  // The helper of the calling thread's priority, started by the first caller of that priority.
   static HelperThread& instance();
   ~HelperThread();
 

@@ -4,6 +4,11 @@
 
 #include <atomic>
 #include <stdexcept>
+#include <thread>
+
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 namespace specdeform {
 namespace {
@@ -29,6 +34,26 @@ TEST(RunPair, CarriesEitherHalfsExceptionBack) {
     if (begin == 0) halves += static_cast<int>(end);
   });
   EXPECT_EQ(halves, 5);
+}
+
+int thread_nice() {
+  return getpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)));
+}
+
+// Each half runs at its caller's priority: a background thread that lowered its own (the
+// transfer's) is helped by a helper as low, and a caller at the normal priority afterwards is not
+// helped by that one (which a busy machine would starve).
+TEST(RunPair, RunsTheOtherHalfAtTheCallersPriority) {
+  const int normal = thread_nice();
+  int low_half = -100, normal_half = -100;
+  std::thread background([&] {
+    ASSERT_EQ(setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), normal + 5), 0);
+    detail::run_pair([] {}, [&] { low_half = thread_nice(); });
+  });
+  background.join();
+  detail::run_pair([] {}, [&] { normal_half = thread_nice(); });
+  EXPECT_EQ(low_half, normal + 5);
+  EXPECT_EQ(normal_half, normal);
 }
 
 }  // namespace

@@ -20,8 +20,9 @@
 //                  anchor set and then updated by the anchors that change (row additions and
 //                  deletions); a frame is O(f) plus one back-substitution with 3 columns, both
 //                  on two threads. In the background (for interactive front ends), a thread
-//                  of its own, at the lowest CPU priority (Linux: frames and the page keep
-//                  the cores), builds the system and factors each new anchor set while
+//                  of its own, at a lower CPU priority (Linux: nice 5; frames and the page
+//                  keep most of the cores, other busy programs leave it its share), builds the
+//                  system and factors each new anchor set while
 //                  apply() adds the details as displacements; apply() switches to the
 //                  transfer once the newest anchors are factored (692k vertices on two idle
 //                  cores: 6-9 s for the first, most of it METIS's ordering; then 1-3 s).
