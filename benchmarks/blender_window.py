@@ -1,7 +1,8 @@
 """How long the add-on holds Blender's window on a large bound file: opened, saved (a copy), then
 Edit Mode entered and left, in a window (Xvfb), against the same steps without the add-on
-(BASELINE=1: Blender's own cost, its draws of the mesh included). A 20 ms timer records the gaps between its ticks (the
-longest time the window could not answer), and each of the add-on's main-thread steps is timed.
+(BASELINE=1: Blender's own cost, its draws of the mesh included). A 20 ms timer records the gaps
+between its ticks (the longest time the window could not answer), and each of the add-on's
+main-thread steps is timed.
 The file is made by blender_large_mesh.py's scene (bound, the target moved, saved):
 
     SPECDEFORM_BLENDER_DIR=build/blender blender -b --factory-startup \\
