@@ -253,7 +253,7 @@ def leave_pose_out_of_new_keys(obj, b):
     panel says what was done (Bake Pose keeps a pose as a key)."""
     mesh = obj.data
     keys = mesh.shape_keys
-    names = tuple(k.name for k in keys.key_blocks) if keys is not None else ()
+    names = mesh_helpers.key_names(mesh)
     if names == b.keys:
         return
     known, b.keys = b.keys, names
@@ -263,7 +263,7 @@ def leave_pose_out_of_new_keys(obj, b):
         keys.reference_key.data.foreach_set("co", b.rest.ravel())
         mesh_helpers.set_coordinates(mesh, b.rest)
         mesh_helpers.add_pose_key(obj)
-        b.keys = tuple(k.name for k in keys.key_blocks)
+        b.keys = mesh_helpers.key_names(mesh)
         _write(obj, b)
         b.status["note"] = ("Shape keys added while bound: the Basis is the rest shape, the pose "
                             f"the add-on's key '{mesh_helpers.POSE_KEY}'")
@@ -395,8 +395,7 @@ def attach(obj, r, job, seconds, keep_shown=False):
         b.last, b.exact, b.written = r.transforms, s.saved_full, True
         if not b.exact:
             _finish_later_once(obj, b, 0.2)
-    keys = obj.data.shape_keys
-    b.keys = tuple(k.name for k in keys.key_blocks) if keys is not None else ()
+    b.keys = mesh_helpers.key_names(obj.data)
     _bindings[obj.name_full] = b
     notices.pop(obj.name_full, None)
     problems.pop(obj.name_full, None)

@@ -44,6 +44,12 @@ def add_pose_key(obj):
     obj.active_shape_key_index = active
 
 
+def key_names(mesh):
+    """The names of the mesh's shape keys, in order (none without keys)."""
+    keys = mesh.shape_keys
+    return tuple(k.name for k in keys.key_blocks) if keys is not None else ()
+
+
 def key_coordinates(key):
     co = np.empty(3 * len(key.data), np.float32)
     key.data.foreach_get("co", co)
@@ -70,21 +76,13 @@ def relative_mix(obj):
 def rest_coordinates(mesh):
     """The shape the deformation starts from: the basis key's, or the mesh's own coordinates."""
     keys = mesh.shape_keys
-    if keys is None:
-        return coordinates(mesh)
-    co = np.empty(3 * len(mesh.vertices), np.float32)
-    keys.reference_key.data.foreach_get("co", co)
-    return co.reshape(-1, 3)
+    return coordinates(mesh) if keys is None else key_coordinates(keys.reference_key)
 
 
 def shown(mesh):
     """The pose as the add-on wrote it: its key's coordinates, or the mesh's own."""
     key = pose_key(mesh)
-    if key is None:
-        return coordinates(mesh)
-    co = np.empty(3 * len(mesh.vertices), np.float32)
-    key.data.foreach_get("co", co)
-    return co.reshape(-1, 3)
+    return coordinates(mesh) if key is None else key_coordinates(key)
 
 
 def show(mesh, co):
