@@ -58,6 +58,7 @@ void add_basis_command(CLI::App& app) {
       j["bands"] = h.bands;
       j["restarts"] = h.restarts;
       j["solves"] = h.solves;
+      j["stages"] = stages_json(h.stages);  // where "seconds" went, in order
       j["eigenvalues"] = std::vector<double>(h.eigenvalues.begin(), h.eigenvalues.end());
       j["residuals"] = std::vector<double>(h.residuals.begin(), h.residuals.end());
       std::cout << json_text(j) << "\n";

@@ -47,6 +47,7 @@ nlohmann::ordered_json bench_mesh(const std::string& name, const TriangleMesh& m
   Stopwatch clock;
   ManifoldHarmonics basis = compute_manifold_harmonics(mesh, o);
   j["PT1_basis"] = clock.seconds();
+  j["basis_stages"] = stages_json(basis.stages);
   if (basis.status != SolveStatus::Converged) throw SolverError(name + ": basis did not converge");
 
   clock = Stopwatch();

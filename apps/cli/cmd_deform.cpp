@@ -46,6 +46,8 @@ void add_deform_command(CLI::App& app) {
   add_write_options(*cmd, args->write);
   cmd->callback([args, cmd] {
     check_mesh_output(args->output);
+    nlohmann::ordered_json timings;
+    Stopwatch clock;
     // The scene's settings override the defaults; options given on the command line win.
     const LoadedScene loaded_scene = load_scene(args->mesh, args->scene, args->deform.options);
     const LoadedMesh& loaded = loaded_scene.mesh;
@@ -65,7 +67,7 @@ void add_deform_command(CLI::App& app) {
         constrained_set(selection, loaded.mesh, options.unconstrained, loaded.info.vertex_to_file,
                         loaded_scene.name);
 
-    nlohmann::ordered_json timings;
+    timings["read"] = clock.seconds();
     std::shared_ptr<const ManifoldHarmonics> basis;
     bool loaded_basis = false;
     if (options.solver == DeformSolver::Spectral) {
@@ -74,15 +76,18 @@ void add_deform_command(CLI::App& app) {
       if (cmd->count("--eigensolver") == 0) {
         h.solver = default_eigensolver(loaded.mesh.num_vertices(), h.policy);
       }
-      const Stopwatch clock;
+      clock = Stopwatch();
       basis = obtain_basis(loaded.mesh, h, args->basis, &loaded_basis);
       timings["basis"] = clock.seconds();
+      timings["basis_stages"] = stages_json(basis->stages);
     } else {
       timings["basis"] = 0.0;
     }
+    clock = Stopwatch();
     const bool approximate = basis && basis->approximate;
     SpectralDeformer deformer(loaded.mesh, std::move(basis), options);
     deformer.set_selection(selection);
+    timings["setup"] = clock.seconds();  // the deformer's, reduced_system and the details' below
     Vertices result;
     const FrameTimings frame = median_frame(deformer, scene.transforms, args->repeat, &result);
     if (!result.allFinite()) throw SolverError("the deformation produced non-finite positions");
@@ -92,7 +97,9 @@ void add_deform_command(CLI::App& app) {
                 << " hold them this loosely (a larger --weight, or --constraints hard, holds "
                    "them closer)\n";
     }
+    clock = Stopwatch();
     write_result(args->output, loaded, result, args->write);
+    timings["write"] = clock.seconds();
     const SetupTimings& s = deformer.setup_timings();
     const ConstraintError& miss = deformer.base_miss();
     const ArapReport& arap = deformer.arap_report();

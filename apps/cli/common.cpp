@@ -191,6 +191,12 @@ ProgressCallback progress_bar(const std::string& label) {
   };
 }
 
+nlohmann::ordered_json stages_json(const std::vector<StageTime>& stages) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
+  for (const StageTime& t : stages) j[t.stage] = t.seconds;
+  return j;
+}
+
 std::string json_text(const nlohmann::ordered_json& j, int indent) {
   return j.dump(indent, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }

@@ -50,6 +50,8 @@ ProgressCallback progress_bar(const std::string& label);
 // JSON text for stdout or a file; bytes that are not UTF-8 (a file name) become U+FFFD, so the
 // text stays valid JSON.
 std::string json_text(const nlohmann::ordered_json& j, int indent = -1);
+// A computation's profile as {"stage": seconds, ...} in the order the stages ran.
+nlohmann::ordered_json stages_json(const std::vector<StageTime>& stages);
 
 // Adds --eigensolver krylov|lanczos|multilevel to `cmd`, bound to `solver`.
 void add_eigensolver_option(CLI::App& cmd, EigenSolver& solver);

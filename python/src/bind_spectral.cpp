@@ -131,6 +131,16 @@ returns (evecs.base). SpectralDeformer shares it without a copy.)")
           "requested_modes", [](const Harmonics& h) { return h.value->requested_modes; },
           "The modes asked for: fewer than the basis holds when several pieces each got their "
           "floor (spectral/piecewise.h).")
+      .def_property_readonly(
+          "stages",
+          [](const Harmonics& h) {
+            py::list out;
+            for (const StageTime& t : h.value->stages)
+              out.append(py::make_tuple(t.stage, t.seconds));
+            return out;
+          },
+          "[(stage, seconds)]: where the computation's time went, in order (empty when read "
+          "from a cache).")
       .def_property_readonly("bands", [](const Harmonics& h) { return h.value->bands; })
       .def_property_readonly("restarts", [](const Harmonics& h) { return h.value->restarts; })
       .def_property_readonly("solves", [](const Harmonics& h) { return h.value->solves; })

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "huge_pages.h"
 #include "parallel.h"
 #include "specdeform/exceptions.h"
 
@@ -168,7 +169,7 @@ Eigen::MatrixXd factored_product(const FactoredBasis& H) {
   const auto& P = H.prolongation;
   const RowMat Z = H.coarse;
   const Eigen::Index m = Z.cols();
-  Eigen::MatrixXd out(P.rows(), m);
+  Eigen::MatrixXd out = large_matrix(P.rows(), m);
   split_in_two(P.rows(), [&](Eigen::Index begin, Eigen::Index end) {
     RowMat tile(kTile, m);
     for (Eigen::Index first = begin; first < end; first += kTile) {

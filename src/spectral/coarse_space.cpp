@@ -5,7 +5,6 @@
 #include <vector>
 
 #include "linalg/parallel.h"
-#include "mesh/graph_distance.h"
 
 namespace specdeform::detail {
 
@@ -36,9 +35,13 @@ void place(std::vector<std::vector<std::pair<int, double>>>& columns, int begin,
 }  // namespace
 
 CoarseSpace partition_of_unity(const Sparse& lengths, int samples, double support) {
-  const int n = static_cast<int>(lengths.rows());
   const EdgeGraph graph = edge_graph(lengths);
-  const Sampling farthest = farthest_points(graph, std::clamp(samples, 1, n));
+  const int n = static_cast<int>(lengths.rows());
+  return partition_of_unity(graph, farthest_points(graph, std::clamp(samples, 1, n)), support);
+}
+
+CoarseSpace partition_of_unity(const EdgeGraph& graph, const Sampling& farthest, double support) {
+  const int n = graph.size();
   CoarseSpace out;
   out.radius = farthest.covering_radius();
   const float rho = static_cast<float>(support * out.radius);

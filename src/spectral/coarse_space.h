@@ -14,6 +14,8 @@
 #include <Eigen/Core>
 #include <Eigen/Sparse>
 
+#include "mesh/graph_distance.h"
+
 namespace specdeform::detail {
 
 struct CoarseSpace {
@@ -28,6 +30,9 @@ struct CoarseSpace {
 // components). support: rho / r, > 1.
 CoarseSpace partition_of_unity(const Eigen::SparseMatrix<double>& lengths, int samples,
                                double support);
+// The same in its two steps: the functions of `farthest`'s seeds (farthest_points on `graph`,
+// the edge graph of the lengths).
+CoarseSpace partition_of_unity(const EdgeGraph& graph, const Sampling& farthest, double support);
 
 // The edges of K (its off-diagonal pattern) with the Euclidean lengths of the positions V (n x 3).
 Eigen::SparseMatrix<double> edge_lengths(const Eigen::SparseMatrix<double>& K,

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "linalg/huge_pages.h"
 #include "linalg/parallel.h"
 
 namespace specdeform::detail {
@@ -22,6 +23,7 @@ bool PairErrors::within(double tolerance, double floor_factor, double factor) co
 namespace {
 
 constexpr int kColumns = 16;
+using Block = Eigen::Matrix<double, Eigen::Dynamic, kColumns, Eigen::RowMajor>;
 using Rows = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>>;
 
 // Sums over the rows [begin, end) of d_i (K h - l M h)_i^2 and, with kFloors,
@@ -72,19 +74,18 @@ __attribute__((target_clones("avx2", "default"))) void sums(const Rows& K, const
   block_sums<false>(K, M, block, l, d_inv, begin, end, residual2, floor2);
 }
 
-}  // namespace
-
-// In blocks of kColumns pairs, each copied row-major, rows split between two threads: per row
-// of K (CSR) one pass over its entries serves all the block's residuals and floors.
-PairErrors pair_errors(const Sparse& K, const Sparse& M, const Mat& H, const Vec& lambda,
-                       bool floors) {
-  using Block = Eigen::Matrix<double, Eigen::Dynamic, kColumns, Eigen::RowMajor>;
+// In blocks of kColumns pairs, each gathered row-major by fill(first column, columns, block),
+// rows split between two threads: per row of K (CSR) one pass over its entries serves all the
+// block's residuals and floors.
+template <typename Fill>
+PairErrors block_errors(const Sparse& K, const Sparse& M, Eigen::Index n, const Vec& lambda,
+                        bool floors, Fill&& fill) {
   using Sums = Eigen::Array<double, kColumns, 1>;
   if (!K.isCompressed() || !M.isCompressed()) {
     Sparse Kc = K, Mc = M;
     Kc.makeCompressed();
     Mc.makeCompressed();
-    return pair_errors(Kc, Mc, H, lambda, floors);
+    return block_errors(Kc, Mc, n, lambda, floors, fill);
   }
   // K and M are symmetric: their compressed columns, read as rows, are their rows (no copy).
   const auto rows = [](const Sparse& A) {
@@ -94,13 +95,13 @@ PairErrors pair_errors(const Sparse& K, const Sparse& M, const Mat& H, const Vec
   const Rows Kr = rows(K), Mr = rows(M);
   const double area = M.sum();
   const Vec d_inv = (M * Vec::Ones(M.rows())).cwiseInverse();
-  const Eigen::Index n = H.rows();
-  PairErrors out{Vec(H.cols()), Vec(H.cols())};
+  const Eigen::Index m = lambda.size();
+  PairErrors out{Vec(m), Vec(m)};
   Block block(n, kColumns);
-  for (Eigen::Index j = 0; j < H.cols(); j += kColumns) {
-    const Eigen::Index c = std::min<Eigen::Index>(kColumns, H.cols() - j);
-    block.setZero();
-    block.leftCols(c) = H.middleCols(j, c);
+  advise_huge_pages(block.data(), sizeof(double) * static_cast<std::size_t>(block.size()));
+  for (Eigen::Index j = 0; j < m; j += kColumns) {
+    const Eigen::Index c = std::min<Eigen::Index>(kColumns, m - j);
+    fill(j, c, block);
     Sums l = Sums::Zero();
     l.head(c) = lambda.segment(j, c).array();
     Sums residual2[2] = {Sums::Zero(), Sums::Zero()}, floor2[2] = {Sums::Zero(), Sums::Zero()};
@@ -117,6 +118,42 @@ PairErrors pair_errors(const Sparse& K, const Sparse& M, const Mat& H, const Vec
     }
   }
   return out;
+}
+
+}  // namespace
+
+PairErrors pair_errors(const Sparse& K, const Sparse& M, const Mat& H, const Vec& lambda,
+                       bool floors) {
+  return block_errors(K, M, H.rows(), lambda, floors,
+                      [&H](Eigen::Index j, Eigen::Index c, Block& block) {
+                        block.setZero();
+                        block.leftCols(c) = H.middleCols(j, c);
+                      });
+}
+
+PairErrors pair_errors(const Sparse& K, const Sparse& M, const FactoredBasis& H, const Vec& lambda,
+                       Vec& largest) {
+  using Column = Eigen::Array<double, 1, kColumns>;
+  const auto& P = H.prolongation;
+  largest = Vec::Zero(H.coarse.cols());
+  return block_errors(
+      K, M, P.rows(), lambda, false, [&](Eigen::Index j, Eigen::Index c, Block& block) {
+        Block Z = Block::Zero(H.coarse.rows(), kColumns);  // the block's columns of Z, row-major
+        Z.leftCols(c) = H.coarse.middleCols(j, c);
+        Column extreme[2] = {Column::Zero(), Column::Zero()};
+        split_in_two(P.rows(), [&](Eigen::Index begin, Eigen::Index end) {
+          Column& e = extreme[begin == 0 ? 0 : 1];
+          for (Eigen::Index i = begin; i < end; ++i) {
+            Column row = Column::Zero();
+            for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P, i); it; ++it)
+              row += it.value() * Z.row(it.index()).array();
+            block.row(i) = row.matrix();
+            e = (row.abs() > e.abs()).select(row, e);
+          }
+        });
+        const Column e = (extreme[1].abs() > extreme[0].abs()).select(extreme[1], extreme[0]);
+        largest.segment(j, c) = e.head(c).matrix().transpose();
+      });
 }
 
 }  // namespace specdeform::detail

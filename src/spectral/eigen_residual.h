@@ -11,6 +11,8 @@
 #include <Eigen/Core>
 #include <Eigen/Sparse>
 
+#include "specdeform/spectral/manifold_harmonics.h"
+
 namespace specdeform::detail {
 
 struct PairErrors {
@@ -22,9 +24,16 @@ struct PairErrors {
   bool within(double tolerance, double floor_factor, double factor = 1.0) const;
 };
 
-// K and M symmetric. floors = false: the floors are left 0 (an approximate basis, whose residuals are orders of
-// magnitude above them: half the work).
+// K and M symmetric. floors = false: the floors are left 0 (an approximate basis, whose
+// residuals are orders of magnitude above them: half the work).
 PairErrors pair_errors(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M,
                        const Eigen::MatrixXd& H, const Eigen::VectorXd& lambda, bool floors = true);
+
+// The same for a factored basis H = P Z without forming H (each block of H's columns gathered
+// from P's rows as it is needed), without floors; `largest` receives each column's entry of
+// largest magnitude, signed (for the sign convention, at no further pass).
+PairErrors pair_errors(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M,
+                       const FactoredBasis& H, const Eigen::VectorXd& lambda,
+                       Eigen::VectorXd& largest);
 
 }  // namespace specdeform::detail

@@ -20,13 +20,16 @@ namespace specdeform::detail {
 
 struct Spectrum {
   Eigen::VectorXd lambda;
-  Eigen::MatrixXd H;
+  Eigen::MatrixXd H;  // empty where `factored` holds it
   SolveStatus status = SolveStatus::Converged;
   int bands = 0, restarts = 0;
   long long solves = 0;
   bool cluster_truncated = false;  // lambda_m (nearly) equals lambda_{m+1}
   int coarse_functions = 0;        // solve_multilevel: N
-  FactoredBasis factored;          // solve_multilevel: H = P Z
+  FactoredBasis factored;          // solve_multilevel: H = P Z, H left to form
+  // solve_multilevel: max |H^T M H - I| = max |Z^T (P^T M P) Z - I|, measured on the coarse
+  // problem (H = P Z exactly).
+  double orthonormality_error = 0.0;
 };
 
 Spectrum solve_dense(const Eigen::SparseMatrix<double>& K, const Eigen::SparseMatrix<double>& M,

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "linalg/basis_product.h"
 #include "linalg/locality_order.h"
 #include "linalg/mass_operator.h"
 #include "linalg/parallel.h"
@@ -15,6 +16,7 @@
 #include "spectral/eigen_residual.h"
 #include "spectral/eigensolvers.h"
 #include "spectral/piecewise.h"
+#include "spectral/stage_clock.h"
 
 namespace specdeform {
 
@@ -130,6 +132,12 @@ detail::Spectrum solve_connected(const Sparse& K, const Sparse& M_unit, const Sp
 ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Sparse* lengths,
                                      const ManifoldHarmonicsOptions& o);
 
+// A factored basis's H = P Z, formed once, in the numbering it is returned in.
+void prolongate(ManifoldHarmonics& h, const ManifoldHarmonicsOptions& o) {
+  detail::report(o, 1.0, "prolongation");
+  h.basis = detail::factored_product(h.factored);
+}
+
 // Both overloads: `lengths` gives the multilevel solver's distances, or null. Meshes of
 // policy.reorder_from vertices or more are solved in a breadth-first numbering
 // (linalg/locality_order.h), the basis's rows put back in theirs.
@@ -139,7 +147,12 @@ ManifoldHarmonics harmonics(const Sparse& K, const Sparse& M, const Sparse* leng
   if (K.rows() != K.cols() || M.rows() != K.rows() || M.cols() != K.rows()) {
     throw InputError("manifold harmonics: K and M must be square matrices of the same size");
   }
-  if (K.rows() < o.policy.reorder_from) return harmonics_in_order(K, M, lengths, o);
+  if (K.rows() < o.policy.reorder_from) {
+    ManifoldHarmonics h = harmonics_in_order(K, M, lengths, o);
+    if (!h.factored.empty()) prolongate(h, o);
+    return h;
+  }
+  detail::report(o, 0.0, "ordering");
   const auto P = detail::breadth_first_order(K);
   Sparse K_ordered, M_ordered, lengths_ordered;
   detail::run_pair([&] { K_ordered = detail::renumbered(K, P); },
@@ -149,8 +162,12 @@ ManifoldHarmonics harmonics(const Sparse& K, const Sparse& M, const Sparse* leng
                    });
   ManifoldHarmonics h =
       harmonics_in_order(K_ordered, M_ordered, lengths ? &lengths_ordered : nullptr, o);
-  detail::permute_rows_back(P, h.basis);
-  if (!h.factored.empty()) detail::permute_rows_back(P, h.factored.prolongation);
+  detail::report(o, 1.0, "numbering back");
+  if (h.factored.empty()) detail::permute_rows_back(P, h.basis);
+  if (!h.factored.empty()) {
+    detail::permute_rows_back(P, h.factored.prolongation);
+    prolongate(h, o);
+  }
   return h;
 }
 
@@ -165,6 +182,7 @@ ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Spa
     throw InputError("manifold harmonics: the number of modes must be in [1, " + std::to_string(n) +
                      "] for this mesh, got " + std::to_string(m));
   }
+  detail::report(o, 0.0, "checks");
   check_operators(K, M, "manifold harmonics");
   const Vec row_sums = M * Vec::Ones(n);
   const double area = row_sums.sum();
@@ -203,20 +221,33 @@ ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Spa
   out.eigenvalues = s.lambda / area;
   out.basis = std::move(s.H);
   out.factored = std::move(s.factored);
-  // Unit area, and the sign convention: each column's largest-magnitude entry positive (the
-  // columns split between two threads: two passes over n x m). A factored basis's Z alike.
-  detail::split_in_two(columns, [&](Eigen::Index begin, Eigen::Index end) {
-    for (Eigen::Index j = begin; j < end; ++j) {
-      Eigen::Index i;
-      out.basis.col(j).cwiseAbs().maxCoeff(&i);
-      const double scale = (out.basis(i, j) < 0 ? -1.0 : 1.0) / std::sqrt(area);
-      out.basis.col(j) *= scale;
-      if (!out.factored.empty()) out.factored.coarse.col(j) *= scale;
-    }
-  });
-  detail::report(o, 1.0, "verification");
-  const detail::PairErrors errors =
-      detail::pair_errors(K, M, out.basis, out.eigenvalues, !multilevel);
+  // Unit area, and the sign convention: each column's largest-magnitude entry positive. A
+  // factored basis is checked from its factors, which give the signs on the way, and its H is
+  // left for the caller to form (in the mesh's numbering: one pass over n x m); a dense one's
+  // columns are split between two threads (two passes over n x m).
+  detail::PairErrors errors;
+  if (!out.factored.empty()) {
+    detail::report(o, 1.0, "verification");
+    out.factored.coarse /= std::sqrt(area);
+    Vec largest;
+    errors = detail::pair_errors(K, M, out.factored, out.eigenvalues, largest);
+    for (int j = 0; j < columns; ++j)
+      if (largest[j] < 0) out.factored.coarse.col(j) *= -1.0;
+    out.max_orthogonality_error = s.orthonormality_error;
+  } else {
+    detail::report(o, 1.0, "signs");
+    detail::split_in_two(columns, [&](Eigen::Index begin, Eigen::Index end) {
+      for (Eigen::Index j = begin; j < end; ++j) {
+        Eigen::Index i;
+        out.basis.col(j).cwiseAbs().maxCoeff(&i);
+        out.basis.col(j) *= (out.basis(i, j) < 0 ? -1.0 : 1.0) / std::sqrt(area);
+      }
+    });
+    detail::report(o, 1.0, "verification");
+    errors = detail::pair_errors(K, M, out.basis, out.eigenvalues, !multilevel);
+    detail::report(o, 1.0, "orthonormality");
+    out.max_orthogonality_error = orthonormality_error(M, out.basis);
+  }
   out.residuals = errors.residual;
   out.max_residual = errors.residual.maxCoeff();
   out.rounding_floor = errors.floor.maxCoeff();
@@ -228,7 +259,6 @@ ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Spa
     out.worst_pair = {static_cast<int>(worst), errors.residual[worst], thresholds[worst],
                       errors.floor[worst]};
   }
-  out.max_orthogonality_error = orthonormality_error(M, out.basis);
   // An approximate basis is not meant to meet the tolerance: its status is the coarse solve's.
   if (!multilevel && !errors.within(o.tolerance, p.floor_factor)) {
     out.status = SolveStatus::NotConverged;
@@ -239,21 +269,29 @@ ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Spa
 }  // namespace
 
 ManifoldHarmonics compute_manifold_harmonics(const Sparse& K, const Sparse& M,
-                                             const ManifoldHarmonicsOptions& o) {
-  return harmonics(K, M, nullptr, o);
+                                             const ManifoldHarmonicsOptions& options) {
+  detail::StageClock clock;
+  ManifoldHarmonicsOptions o = options;
+  o.progress = clock.wrap(options.progress);
+  ManifoldHarmonics h = harmonics(K, M, nullptr, o);
+  h.stages = clock.stop();
+  return h;
 }
 
 ManifoldHarmonics compute_manifold_harmonics(const TriangleMesh& mesh,
                                              const ManifoldHarmonicsOptions& options) {
-  detail::report(options, 0.0, "the Laplacian");
-  const LaplacianOperators L = laplacian_operators(mesh, options.mass, options.laplacian);
-  const Sparse lengths = options.solver == EigenSolver::Multilevel
-                             ? detail::edge_lengths(L.stiffness, mesh.V)
-                             : Sparse();
-  ManifoldHarmonics h = harmonics(
-      L.stiffness, L.mass, options.solver == EigenSolver::Multilevel ? &lengths : nullptr, options);
-  h.mass = options.mass;
-  h.laplacian = options.laplacian;
+  detail::StageClock clock;
+  ManifoldHarmonicsOptions o = options;
+  o.progress = clock.wrap(options.progress);
+  detail::report(o, 0.0, "the Laplacian");
+  const LaplacianOperators L = laplacian_operators(mesh, o.mass, o.laplacian);
+  const bool multilevel = o.solver == EigenSolver::Multilevel;
+  if (multilevel) detail::report(o, 0.0, "edge lengths");
+  const Sparse lengths = multilevel ? detail::edge_lengths(L.stiffness, mesh.V) : Sparse();
+  ManifoldHarmonics h = harmonics(L.stiffness, L.mass, multilevel ? &lengths : nullptr, o);
+  h.mass = o.mass;
+  h.laplacian = o.laplacian;
+  h.stages = clock.stop();
   return h;
 }
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numeric>
 
+#include "linalg/basis_product.h"
+
 namespace specdeform::detail {
 
 using Sparse = Eigen::SparseMatrix<double>;
@@ -99,6 +101,7 @@ Spectrum solve_by_piece(const Sparse& K, const Sparse& M, const Sparse* lengths,
                        lengths ? &piece_lengths : nullptr, piece);
     for (const int v : index[c]) local[v] = -1;
     done += vertices[c];
+    if (!s.factored.empty()) s.H = factored_product(s.factored);  // pieces are gathered into one H
     // From the piece's unit-area scale to M's: K h = (lambda / a) M h, h^T M h = a.
     s.lambda /= area[c];
     s.H /= std::sqrt(area[c]);

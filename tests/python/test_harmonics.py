@@ -192,9 +192,17 @@ def test_bad_arguments(bar):
 
 def test_progress_is_reported_and_its_exception_aborts(bar):
     stages = []
-    specdeform.manifold_harmonics(*bar, 10, progress=lambda f, s: stages.append((f, s)))
-    assert stages[-1] == (1.0, "verification")
+    _, vectors = specdeform.manifold_harmonics(
+        *bar, 10, progress=lambda f, s: stages.append((f, s))
+    )
+    assert stages[-1][0] == 1.0 and (1.0, "verification") in stages
     assert all(0 <= f <= 1 for f, _ in stages)
+    # The basis's profile: every stage, once, in order, with its seconds (the progress passed on
+    # to Python is thinned out: a subsequence of it).
+    profiled = [s for s, _ in vectors.base.stages]
+    named = [s for _, s in stages]
+    assert [s for s in profiled if s in named] == sorted(set(named), key=named.index)
+    assert all(seconds >= 0 for _, seconds in vectors.base.stages)
 
     class Stop(Exception):
         pass

@@ -4,12 +4,16 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "specdeform/deform/spectral_deformer.h"
 #include "specdeform/mesh/generate.h"
 #include "specdeform/mesh/mesh_info.h"
+#include "specdeform/operators/laplacian.h"
 #include "specdeform/operators/mass_matrix.h"
 #include "specdeform/spectral/manifold_harmonics.h"
 #include "support/corpus.h"
@@ -137,6 +141,65 @@ TEST(MultilevelBasis, KeepsItsFactors) {
   o.num_modes = 12;
   o.solver = EigenSolver::Multilevel;
   EXPECT_TRUE(compute_manifold_harmonics(two, o).factored.empty());
+}
+
+// The residuals, the orthonormality and the signs come from P and Z without H (the
+// verification gathers H's columns from P's rows, the orthonormality is the coarse problem's,
+// and H is formed last, in the mesh's numbering): each must be H's own.
+TEST(MultilevelBasis, ItsChecksFromTheFactorsAreTheBasisOwn) {
+  const TriangleMesh torus = make_torus(1.0, 0.35, 100, 40);
+  const LaplacianOperators L = laplacian_operators(torus, MassType::Lumped, LaplacianType::Cotan);
+  for (const int reorder_from : {0, 1 << 30}) {
+    ManifoldHarmonicsOptions o;
+    o.num_modes = 40;
+    o.solver = EigenSolver::Multilevel;
+    o.policy.reorder_from = reorder_from;
+    const ManifoldHarmonics h = compute_manifold_harmonics(torus, o);
+    ASSERT_FALSE(h.factored.empty());
+    const double residual = eigen_residual(L.stiffness, L.mass, h.basis, h.eigenvalues);
+    EXPECT_NEAR(h.max_residual, residual, 1e-12 * residual) << reorder_from;
+    EXPECT_NEAR(h.max_orthogonality_error, orthonormality_error(L.mass, h.basis), 1e-13);
+    EXPECT_LT(h.max_orthogonality_error, 1e-12);
+    for (int j = 0; j < h.basis.cols(); ++j) {
+      Eigen::Index i;
+      h.basis.col(j).cwiseAbs().maxCoeff(&i);
+      EXPECT_GT(h.basis(i, j), 0.0) << j;
+    }
+  }
+}
+
+// The profile names the multilevel path's stages in the order they ran; their seconds add up to
+// the computation's (the clock runs from the first stage to the return).
+TEST(MultilevelBasis, ProfilesItsStages) {
+  const TriangleMesh torus = make_torus(1.0, 0.35, 100, 40);
+  ManifoldHarmonicsOptions o;
+  o.num_modes = 40;
+  o.solver = EigenSolver::Multilevel;
+  o.policy.reorder_from = 0;
+  std::vector<std::string> reported;
+  o.progress = [&](double, std::string_view stage) {
+    if (reported.empty() || reported.back() != stage) reported.emplace_back(stage);
+  };
+  const auto start = std::chrono::steady_clock::now();
+  const ManifoldHarmonics h = compute_manifold_harmonics(torus, o);
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::vector<std::string> stages;
+  double sum = 0.0;
+  for (const StageTime& t : h.stages) {
+    stages.push_back(t.stage);
+    EXPECT_GE(t.seconds, 0.0) << t.stage;
+    sum += t.seconds;
+  }
+  EXPECT_EQ(stages, reported);  // each once: one piece
+  for (const char* stage :
+       {"the Laplacian", "edge lengths", "ordering", "sampling", "coarse space", "coarse operators",
+        "coarse eigenvectors", "verification", "numbering back", "prolongation"}) {
+    EXPECT_NE(std::ranges::find(stages, stage), stages.end()) << stage;
+  }
+  EXPECT_EQ(stages.back(), "prolongation");
+  EXPECT_LE(sum, elapsed);
+  EXPECT_GT(sum, 0.9 * elapsed - 0.01);
 }
 
 // A mesh smaller than multilevel_reduction times the coarse space gets the exact solver.

@@ -45,6 +45,7 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Sparse>
@@ -142,6 +143,12 @@ int default_modes(int vertices);
 
 enum class SolveStatus { Converged, NotConverged };
 
+// One stage of a computation, as its progress names it, and the wall-clock seconds spent in it.
+struct StageTime {
+  std::string stage;
+  double seconds = 0.0;
+};
+
 // A basis held as the multilevel solver makes it: H = P Z, P n x N sparse (rows summing to 1, a
 // dozen entries each), Z N x m. A frame's product H c = P (Z c) reads P, not H: at 692k
 // vertices ~100 MB against H's 553 MB (277 MB in float32).
@@ -200,6 +207,9 @@ struct ManifoldHarmonics {
   int bands = 0;  // shifts used (= factorizations)
   int restarts = 0;
   long long solves = 0;  // right-hand sides solved with the factorization
+  // Where the time went, in the order the stages came (each summed over the pieces); empty for a
+  // basis read from a file.
+  std::vector<StageTime> stages;
 };
 
 ManifoldHarmonics compute_manifold_harmonics(const TriangleMesh& mesh,

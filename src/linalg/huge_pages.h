@@ -1,0 +1,21 @@
+// Internal: large dense matrices on the kernel's 2 MB pages. Linux lends transparent huge pages
+// to the memory a program asks for them (madvise, the default mode of Debian's kernels): a pass
+// over a 553 MB basis (692k vertices, m = 100) at 4 KB pages takes 135,000 page faults the first
+// time and a TLB miss on every 4 KB after; on a virtual machine, whose every miss walks two page
+// tables, that was most of the multilevel basis's time (docs/results.md, "Large meshes"). A no-op
+// where the kernel does not lend them or the memory is smaller than a few pages.
+#pragma once
+
+#include <cstddef>
+
+#include <Eigen/Core>
+
+namespace specdeform::detail {
+
+// Asks for huge pages on the whole 2 MB pages inside [data, data + bytes), before it is written.
+void advise_huge_pages(void* data, std::size_t bytes);
+
+// An uninitialised rows x cols matrix, advised so.
+Eigen::MatrixXd large_matrix(Eigen::Index rows, Eigen::Index cols);
+
+}  // namespace specdeform::detail
