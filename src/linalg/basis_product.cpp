@@ -123,6 +123,35 @@ void add_factored_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
   });
 }
 
+// H = P Z's rows [begin, end) into H (column-major, leading dimension n), Z row-major with
+// `padded` columns (zeros past m): per tile of kTile rows and chunk of kChunk columns, each row's
+// kChunk sums kept in registers over its entries of P (in their order, as a plain sum would
+// take them), then stored a column of the tile at a time.
+constexpr int kTile = 64;
+constexpr int kChunk = 16;
+using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+__attribute__((target_clones("avx2", "default"))) void prolongate_rows(
+    const int* start, const int* column, const double* value, const double* Z, Eigen::Index padded,
+    Eigen::Index m, double* H, Eigen::Index n, Eigen::Index begin, Eigen::Index end) {
+  alignas(64) double tile[kChunk][kTile];
+  for (Eigen::Index first = begin; first < end; first += kTile) {
+    const int rows = static_cast<int>(std::min<Eigen::Index>(kTile, end - first));
+    for (Eigen::Index c = 0; c < m; c += kChunk) {
+      for (int r = 0; r < rows; ++r) {
+        double sum[kChunk] = {};
+        for (int e = start[first + r]; e < start[first + r + 1]; ++e) {
+          const double v = value[e];
+          const double* z = Z + column[e] * padded + c;
+          for (int q = 0; q < kChunk; ++q) sum[q] += v * z[q];
+        }
+        for (int q = 0; q < kChunk; ++q) tile[q][r] = sum[q];
+      }
+      const int width = static_cast<int>(std::min<Eigen::Index>(kChunk, m - c));
+      for (int q = 0; q < width; ++q) std::copy_n(tile[q], rows, H + (c + q) * n + first);
+    }
+  }
+}
+
 }  // namespace
 
 void add_basis_product(const Eigen::MatrixX3d& base, const Eigen::MatrixXd& H,
@@ -164,25 +193,15 @@ void add_basis_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
 }
 
 Eigen::MatrixXd factored_product(const FactoredBasis& H) {
-  constexpr Eigen::Index kTile = 64;
-  using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   const auto& P = H.prolongation;
-  const RowMat Z = H.coarse;
-  const Eigen::Index m = Z.cols();
+  const Eigen::Index m = H.coarse.cols();
+  const Eigen::Index padded = (m + kChunk - 1) / kChunk * kChunk;
+  RowMajor Z = RowMajor::Zero(H.coarse.rows(), padded);
+  Z.leftCols(m) = H.coarse;
   Eigen::MatrixXd out = large_matrix(P.rows(), m);
   split_in_two(P.rows(), [&](Eigen::Index begin, Eigen::Index end) {
-    RowMat tile(kTile, m);
-    for (Eigen::Index first = begin; first < end; first += kTile) {
-      const Eigen::Index rows = std::min(kTile, end - first);
-      tile.setZero();
-      for (Eigen::Index r = 0; r < rows; ++r) {
-        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P, first + r); it;
-             ++it) {
-          tile.row(r) += it.value() * Z.row(it.index());
-        }
-      }
-      out.middleRows(first, rows) = tile.topRows(rows);
-    }
+    prolongate_rows(P.outerIndexPtr(), P.innerIndexPtr(), P.valuePtr(), Z.data(), padded, m,
+                    out.data(), P.rows(), begin, end);
   });
   return out;
 }

@@ -31,8 +31,9 @@ void add_basis_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
 void add_basis_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
                        const Eigen::MatrixX3d& C, Eigen::Ref<FloatVertices> out);
 
-// H = P Z itself (n x m, column-major): each row gathered into a row-major tile of 64 rows,
-// stored into H's columns a tile at a time, on two threads.
+// H = P Z itself (n x m, column-major, on huge pages: linalg/huge_pages.h): per tile of 64 rows
+// and 16 columns each row's sums in registers, stored into H's columns a tile at a time, on two
+// threads.
 Eigen::MatrixXd factored_product(const FactoredBasis& H);
 
 }  // namespace specdeform::detail

@@ -4,6 +4,7 @@
 #include <utility>
 #include <vector>
 
+#include "linalg/huge_pages.h"
 #include "linalg/parallel.h"
 
 namespace specdeform::detail {
@@ -78,15 +79,25 @@ void permute_rows_back(const Permutation& P, Eigen::MatrixXd& X) {
 
 void permute_rows_back(const Permutation& P, Eigen::SparseMatrix<double, Eigen::RowMajor>& X) {
   const int* to = P.indices().data();
-  Eigen::SparseMatrix<double, Eigen::RowMajor> out(X.rows(), X.cols());
-  out.reserve(X.nonZeros());
-  for (Eigen::Index i = 0; i < X.rows(); ++i) {
-    out.startVec(i);
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(X, to[i]); it; ++it)
-      out.insertBack(i, it.index()) = it.value();
-  }
-  out.finalize();
-  X = std::move(out);
+  const Eigen::Index n = X.rows();
+  if (!X.isCompressed()) X.makeCompressed();
+  const int* start = X.outerIndexPtr();
+  Eigen::SparseMatrix<double, Eigen::RowMajor> out(n, X.cols());
+  int* out_start = out.outerIndexPtr();
+  out_start[0] = 0;
+  for (Eigen::Index i = 0; i < n; ++i)
+    out_start[i + 1] = out_start[i] + start[to[i] + 1] - start[to[i]];
+  out.resizeNonZeros(out_start[n]);
+  advise_huge_pages(out.valuePtr(), sizeof(double) * out_start[n]);
+  advise_huge_pages(out.innerIndexPtr(), sizeof(int) * out_start[n]);
+  split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index i = begin; i < end; ++i) {
+      const int from = start[to[i]], size = start[to[i] + 1] - from;
+      std::copy_n(X.innerIndexPtr() + from, size, out.innerIndexPtr() + out_start[i]);
+      std::copy_n(X.valuePtr() + from, size, out.valuePtr() + out_start[i]);
+    }
+  });
+  X.swap(out);  // Eigen's sparse matrices have no moves
 }
 
 }  // namespace specdeform::detail

@@ -74,6 +74,25 @@ __attribute__((target_clones("avx2", "default"))) void sums(const Rows& K, const
   block_sums<false>(K, M, block, l, d_inv, begin, end, residual2, floor2);
 }
 
+// Rows [begin, end) of P Z into `block` (row-major, kColumns wide), Z row-major kColumns wide,
+// and into `extreme` each column's entry of largest magnitude among them (signed).
+__attribute__((target_clones("avx2", "default"))) void gather_rows(
+    const int* start, const int* column, const double* value, const double* Z, Eigen::Index begin,
+    Eigen::Index end, double* block, double* extreme) {
+  for (Eigen::Index i = begin; i < end; ++i) {
+    double row[kColumns] = {};
+    for (int e = start[i]; e < start[i + 1]; ++e) {
+      const double v = value[e];
+      const double* z = Z + kColumns * Eigen::Index{column[e]};
+      for (int q = 0; q < kColumns; ++q) row[q] += v * z[q];
+    }
+    for (int q = 0; q < kColumns; ++q) {
+      block[kColumns * i + q] = row[q];
+      if (std::abs(row[q]) > std::abs(extreme[q])) extreme[q] = row[q];
+    }
+  }
+}
+
 // In blocks of kColumns pairs, each gathered row-major by fill(first column, columns, block),
 // rows split between two threads: per row of K (CSR) one pass over its entries serves all the
 // block's residuals and floors.
@@ -133,26 +152,21 @@ PairErrors pair_errors(const Sparse& K, const Sparse& M, const Mat& H, const Vec
 
 PairErrors pair_errors(const Sparse& K, const Sparse& M, const FactoredBasis& H, const Vec& lambda,
                        Vec& largest) {
-  using Column = Eigen::Array<double, 1, kColumns>;
   const auto& P = H.prolongation;
   largest = Vec::Zero(H.coarse.cols());
   return block_errors(
       K, M, P.rows(), lambda, false, [&](Eigen::Index j, Eigen::Index c, Block& block) {
         Block Z = Block::Zero(H.coarse.rows(), kColumns);  // the block's columns of Z, row-major
         Z.leftCols(c) = H.coarse.middleCols(j, c);
-        Column extreme[2] = {Column::Zero(), Column::Zero()};
+        double extreme[2][kColumns] = {};
         split_in_two(P.rows(), [&](Eigen::Index begin, Eigen::Index end) {
-          Column& e = extreme[begin == 0 ? 0 : 1];
-          for (Eigen::Index i = begin; i < end; ++i) {
-            Column row = Column::Zero();
-            for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P, i); it; ++it)
-              row += it.value() * Z.row(it.index()).array();
-            block.row(i) = row.matrix();
-            e = (row.abs() > e.abs()).select(row, e);
-          }
+          gather_rows(P.outerIndexPtr(), P.innerIndexPtr(), P.valuePtr(), Z.data(), begin, end,
+                      block.data(), extreme[begin == 0 ? 0 : 1]);
         });
-        const Column e = (extreme[1].abs() > extreme[0].abs()).select(extreme[1], extreme[0]);
-        largest.segment(j, c) = e.head(c).matrix().transpose();
+        for (Eigen::Index q = 0; q < c; ++q) {
+          largest[j + q] =
+              std::abs(extreme[1][q]) > std::abs(extreme[0][q]) ? extreme[1][q] : extreme[0][q];
+        }
       });
 }
 

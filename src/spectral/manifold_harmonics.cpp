@@ -154,11 +154,16 @@ ManifoldHarmonics harmonics(const Sparse& K, const Sparse& M, const Sparse* leng
   }
   detail::report(o, 0.0, "ordering");
   const auto P = detail::breadth_first_order(K);
+  // Swapped in: Eigen's sparse matrices are copied when assigned, even from a temporary.
   Sparse K_ordered, M_ordered, lengths_ordered;
-  detail::run_pair([&] { K_ordered = detail::renumbered(K, P); },
+  const auto renumber = [&P](const Sparse& A, Sparse& out) {
+    Sparse renumbered = detail::renumbered(A, P);
+    out.swap(renumbered);
+  };
+  detail::run_pair([&] { renumber(K, K_ordered); },
                    [&] {
-                     M_ordered = detail::renumbered(M, P);
-                     if (lengths) lengths_ordered = detail::renumbered(*lengths, P);
+                     renumber(M, M_ordered);
+                     if (lengths) renumber(*lengths, lengths_ordered);
                    });
   ManifoldHarmonics h =
       harmonics_in_order(K_ordered, M_ordered, lengths ? &lengths_ordered : nullptr, o);

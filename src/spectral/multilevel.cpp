@@ -53,7 +53,7 @@ Spectrum solve_multilevel(const Sparse& K, const Sparse& M, const Sparse& length
   };
   ManifoldHarmonics h = compute_manifold_harmonics(Kc, Mc, co);
   Spectrum out;
-  out.factored.prolongation = std::move(coarse.rows);
+  out.factored.prolongation.swap(coarse.rows);
   out.factored.prolongation.makeCompressed();
   out.factored.coarse = h.basis.leftCols(m);
   out.orthonormality_error = h.max_orthogonality_error;

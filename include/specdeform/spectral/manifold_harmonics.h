@@ -156,6 +156,21 @@ struct FactoredBasis {
   Eigen::SparseMatrix<double, Eigen::RowMajor> prolongation;  // P, compressed
   Eigen::MatrixXd coarse;                                     // Z
 
+  FactoredBasis() = default;
+  FactoredBasis(const FactoredBasis&) = default;
+  FactoredBasis& operator=(const FactoredBasis&) = default;
+  // Eigen 3.4's sparse matrices have no moves (a "move" copies): these swap, so that a basis
+  // handed on (and a ManifoldHarmonics or a Spectrum holding one) is not copied.
+  FactoredBasis(FactoredBasis&& other) noexcept { swap(other); }
+  FactoredBasis& operator=(FactoredBasis&& other) noexcept {
+    FactoredBasis(std::move(other)).swap(*this);
+    return *this;
+  }
+  void swap(FactoredBasis& other) noexcept {
+    prolongation.swap(other.prolongation);
+    coarse.swap(other.coarse);
+  }
+
   bool empty() const { return coarse.size() == 0; }
   // Whether P and Z are fewer bytes than H with `scalar_bytes` (8 or 4) per entry, so that a
   // frame's product reads less and a cache file holds less: from m of about 40 on. False when
