@@ -10,7 +10,6 @@
 #include <fstream>
 #include <numeric>
 #include <span>
-#include <unordered_map>
 #include <unordered_set>
 
 #include "file_layout.h"
@@ -68,15 +67,50 @@ std::vector<int> fan_apexes(const detail::PolygonSoup& soup) {
 
 namespace detail {
 
+PositionIndex::PositionIndex(const std::vector<double>& xyz, size_t expected) : xyz_(xyz) {
+  slots_.assign(std::bit_ceil(std::max<size_t>(16, 2 * expected)), -1);
+}
+
+size_t PositionIndex::slot_of(int v) const {
+  uint64_t h = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double c = xyz_[3 * size_t(v) + k] + 0.0;  // -0.0 as +0.0
+    h = (h ^ std::bit_cast<uint64_t>(c)) * 0x9e3779b97f4a7c15ULL;
+    h ^= h >> 29;
+  }
+  return h & (slots_.size() - 1);
+}
+
+int PositionIndex::first_at(int v) {
+  const double* p = xyz_.data() + 3 * size_t(v);
+  for (size_t s = slot_of(v);; s = (s + 1) & (slots_.size() - 1)) {
+    const int u = slots_[s];
+    if (u < 0) {
+      slots_[s] = v;
+      if (2 * ++count_ > slots_.size()) grow();
+      return v;
+    }
+    const double* q = xyz_.data() + 3 * size_t(u);
+    if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) return u;
+  }
+}
+
+void PositionIndex::grow() {
+  std::vector<int> old(2 * slots_.size(), -1);
+  old.swap(slots_);
+  for (const int v : old) {
+    if (v < 0) continue;
+    size_t s = slot_of(v);
+    while (slots_[s] >= 0) s = (s + 1) & (slots_.size() - 1);
+    slots_[s] = v;
+  }
+}
+
 std::vector<int> weld_coincident(const std::vector<double>& xyz) {
   const int n = static_cast<int>(xyz.size() / 3);
-  std::unordered_map<std::array<double, 3>, int, PositionHash> first;
-  first.reserve(n);
+  PositionIndex index(xyz, n);
   std::vector<int> weld(n);
-  for (int v = 0; v < n; ++v) {
-    const std::array<double, 3> p{xyz[3 * v] + 0.0, xyz[3 * v + 1] + 0.0, xyz[3 * v + 2] + 0.0};
-    weld[v] = first.try_emplace(p, v).first->second;
-  }
+  for (int v = 0; v < n; ++v) weld[v] = index.first_at(v);
   return weld;
 }
 

@@ -1,10 +1,7 @@
 // Internal: what every format reader produces before validation and clean-up.
 #pragma once
 
-#include <array>
-#include <cstdint>
-#include <cstring>
-#include <functional>
+#include <cstddef>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,17 +31,23 @@ struct KeptRecord {
   FileLayout layout;
 };
 
-// Hashes a position's bits (callers add +0.0 first, so that -0.0 and +0.0 weld).
-struct PositionHash {
-  size_t operator()(const std::array<double, 3>& p) const {
-    size_t h = 0;
-    for (const double v : p) {
-      uint64_t bits;
-      std::memcpy(&bits, &v, sizeof bits);
-      h ^= std::hash<uint64_t>{}(bits) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
-    }
-    return h;
-  }
+// The first vertex at each exact position (-0.0 as +0.0; a NaN matches nothing): an
+// open-addressing table of indices into the caller's coordinates (3 per vertex), which it reads
+// where they are, so that they may grow between calls. A node-based map of positions took 0.3 s
+// of reading a 692k-vertex OBJ.
+class PositionIndex {
+ public:
+  explicit PositionIndex(const std::vector<double>& xyz, size_t expected = 0);
+  // The first vertex added at vertex v's position; v itself (now added) when none was.
+  int first_at(int v);
+
+ private:
+  size_t slot_of(int v) const;
+  void grow();
+
+  const std::vector<double>& xyz_;
+  std::vector<int> slots_;  // a vertex, or -1 for an empty slot; the size a power of two
+  size_t count_ = 0;
 };
 
 // Each vertex of `xyz` (3 per vertex) welded into the first at exactly the same position (-0.0

@@ -1,9 +1,7 @@
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <string>
-#include <unordered_map>
 
 #include "mesh/polygon_soup.h"
 #include "mesh/text_scanner.h"
@@ -23,21 +21,20 @@ class Welder {
       throw InputError(name_ + ": triangle " + std::to_string(soup_.num_polygons()) +
                        " has a NaN or infinite coordinate");
     }
-    // Adding +0.0 turns -0.0 into +0.0, so the two zeros weld.
-    const std::array<double, 3> p{x + 0.0, y + 0.0, z + 0.0};
-    const auto [it, inserted] = index_.try_emplace(p, soup_.num_vertices());
-    if (inserted) {
-      soup_.xyz.insert(soup_.xyz.end(), p.begin(), p.end());
-    } else {
+    const int v = soup_.num_vertices();
+    soup_.xyz.insert(soup_.xyz.end(), {x + 0.0, y + 0.0, z + 0.0});  // -0.0 as +0.0
+    const int first = index_.first_at(v);
+    if (first != v) {
+      soup_.xyz.resize(3 * size_t(v));
       ++soup_.welded_corners;
     }
-    soup_.add_polygon_corner(it->second);
+    soup_.add_polygon_corner(first);
   }
 
  private:
   PolygonSoup& soup_;
   const std::string& name_;
-  std::unordered_map<std::array<double, 3>, int, PositionHash> index_;
+  PositionIndex index_{soup_.xyz};
 };
 
 PolygonSoup parse_binary(std::string_view data, const std::string& name, KeptRecord* keep) {
