@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "linalg/huge_pages.h"
 #include "linalg/parallel.h"
 
 namespace specdeform::detail {
@@ -30,6 +31,36 @@ void place(std::vector<std::vector<std::pair<int, double>>>& columns, int begin,
     }
     columns[j] = {};
   }
+}
+
+// P = R in column-major storage by counting, on huge pages, each thread placing half of the
+// columns (Eigen's conversion is the same counting, on one thread and 4 KB pages).
+void column_major(const Eigen::SparseMatrix<double, Eigen::RowMajor>& R, Sparse& P) {
+  const int n = static_cast<int>(R.rows()), N = static_cast<int>(R.cols());
+  const int nnz = static_cast<int>(R.nonZeros());
+  const int* row_start = R.outerIndexPtr();
+  const int* column = R.innerIndexPtr();
+  const double* value = R.valuePtr();
+  P.resize(n, N);
+  P.resizeNonZeros(nnz);
+  advise_huge_pages(P.valuePtr(), sizeof(double) * nnz);
+  advise_huge_pages(P.innerIndexPtr(), sizeof(int) * nnz);
+  int* start = P.outerIndexPtr();
+  std::fill_n(start, N + 1, 0);
+  for (int e = 0; e < nnz; ++e) ++start[column[e] + 1];
+  for (int j = 0; j < N; ++j) start[j + 1] += start[j];
+  std::vector<int> fill(start, start + N);
+  const auto place_columns = [&](int first, int last) {
+    for (int i = 0; i < n; ++i) {
+      for (int e = row_start[i]; e < row_start[i + 1]; ++e) {
+        if (column[e] < first || column[e] >= last) continue;
+        const int at = fill[column[e]]++;
+        P.innerIndexPtr()[at] = i;
+        P.valuePtr()[at] = value[e];
+      }
+    }
+  };
+  run_pair([&] { place_columns(0, N / 2); }, [&] { place_columns(N / 2, N); });
 }
 
 }  // namespace
@@ -79,6 +110,8 @@ CoarseSpace partition_of_unity(const EdgeGraph& graph, const Sampling& farthest,
   start[0] = 0;
   for (int i = 0; i < n; ++i) start[i + 1] = start[i] + count[0][i] + count[1][i];
   R.resizeNonZeros(start[n]);
+  advise_huge_pages(R.valuePtr(), sizeof(double) * start[n]);
+  advise_huge_pages(R.innerIndexPtr(), sizeof(int) * start[n]);
   run_pair(
       [&] {
         for (int i = 0; i < n; ++i) count[0][i] = start[i];
@@ -97,7 +130,7 @@ CoarseSpace partition_of_unity(const EdgeGraph& graph, const Sampling& farthest,
       for (int e = start[i]; e < start[i + 1]; ++e) value[e] /= sum;
     }
   });
-  out.prolongation = R;  // Eigen's transposition is the same counting
+  column_major(R, out.prolongation);
   return out;
 }
 
