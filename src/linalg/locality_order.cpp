@@ -46,6 +46,8 @@ Eigen::SparseMatrix<double> renumbered(const Eigen::SparseMatrix<double>& A, con
   const int* to = P.indices().data();
   Eigen::SparseMatrix<double> B(A.rows(), n);
   B.resizeNonZeros(A.nonZeros());
+  advise_huge_pages(B.valuePtr(), sizeof(double) * A.nonZeros());
+  advise_huge_pages(B.innerIndexPtr(), sizeof(int) * A.nonZeros());
   int* start = B.outerIndexPtr();
   start[0] = 0;
   for (int j = 0; j < n; ++j) start[to[j] + 1] = A.outerIndexPtr()[j + 1] - A.outerIndexPtr()[j];

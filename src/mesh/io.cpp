@@ -139,7 +139,10 @@ LoadedMesh build_mesh(PolygonSoup soup, const std::string& name) {
   if (!soup.weld.empty()) {
     for (int& v : soup.indices) v = soup.weld[v];
   }
-  std::vector<int> tris;
+  std::vector<int> tris;  // 3 per triangle: k - 2 of a polygon of k corners
+  const auto fans = std::ssize(soup.indices) - 2 * std::ptrdiff_t{soup.num_polygons()};
+  tris.reserve(3 * std::max<std::ptrdiff_t>(fans, 0));
+  info.face_to_file.reserve(tris.capacity() / 3);
   const std::vector<int> apex = fan_apexes(soup);
   for (int p = 0; p < soup.num_polygons(); ++p) {
     const int* v = soup.indices.data() + soup.offsets[p];
