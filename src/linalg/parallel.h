@@ -37,9 +37,11 @@ class HelperThread {
 
   std::mutex busy_;  // held by the caller of run()
   std::atomic<const std::function<void()>*> job_{nullptr};
-  std::mutex mutex_;  // guards the sleep
-  std::condition_variable wake_;
+  std::mutex mutex_;              // guards the sleeps
+  std::condition_variable wake_;  // the helper's, for a job
+  std::condition_variable done_;  // the caller's, for the helper's half
   bool sleeping_ = false;
+  bool waiting_ = false;
   bool stop_ = false;
   std::thread thread_;
 };
