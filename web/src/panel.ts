@@ -409,16 +409,18 @@ export class Panel {
       }
     })();
     const working = cls === 'busy' && phase.kind !== 'loading' && phase.kind !== 'empty';
-    setText($('status'), working ? this.aged(text, text) : text);
+    const factoring = phase.kind === 'ready' && !!s.server?.detail_pending;
+    setText($('status'), working ? this.aged(text, text, factoring ? s.detailSince : undefined) : text);
     $('status').className = cls;
     if (phase.kind === 'loading') setText($('progress-stage'), this.aged(phase.stage, progressText(phase)));
   }
 
-  // `text` with the seconds since `stage` began (from 1 s on).
-  private aged(stage: string, text: string): string {
+  // `text` with the seconds since `stage` began (from 1 s on), or since `since` where the state
+  // knows when the wait began.
+  private aged(stage: string, text: string, since?: number): string {
     const now = performance.now();
     if (stage !== this.stage.name) this.stage = { name: stage, since: now };
-    const seconds = Math.floor((now - this.stage.since) / 1000);
+    const seconds = Math.floor((now - (since ?? this.stage.since)) / 1000);
     return seconds >= 1 ? `${text} · ${seconds} s` : text;
   }
   private stage = { name: '', since: 0 };
