@@ -25,7 +25,7 @@ void add_basis_command(CLI::App& app) {
   cmd->add_flag("--json", args->json, "print one JSON object on stdout");
   add_harmonics_options(*cmd, args->options);
   cmd->callback([args, cmd] {
-    const LoadedMesh loaded = load_mesh(args->mesh);
+    const LoadedMesh loaded = load_geometry(args->mesh);
     ManifoldHarmonicsOptions o = args->options;
     o.num_modes = modes_for(o.num_modes, cmd->count("--modes") > 0, loaded.mesh.num_vertices());
     o.progress = progress_bar("manifold harmonics");

@@ -146,7 +146,7 @@ void add_bench_command(CLI::App& app) {
     options.validate();
     std::vector<std::pair<std::string, TriangleMesh>> meshes;
     for (const std::string& path : args->meshes) {
-      meshes.emplace_back(std::filesystem::path(path).stem().string(), load_mesh(path).mesh);
+      meshes.emplace_back(std::filesystem::path(path).stem().string(), load_geometry(path).mesh);
     }
     if (meshes.empty()) {
       for (const int cells : args->quick ? std::vector<int>{6, 10} : std::vector<int>{16, 32, 49}) {

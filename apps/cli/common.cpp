@@ -128,10 +128,10 @@ DeformOptions DeformArgs::merged(const CLI::App& cmd, const DeformOptions& scene
   return o;
 }
 
-LoadedMesh load_mesh(const std::string& path, Confinement confinement) {
-  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
-  LoadedMesh loaded =
-      read_mesh(path, {.keep_file = true, .companions = folder_resolver(folder, confinement)});
+namespace {
+
+LoadedMesh load(const std::string& path, const ReadOptions& options) {
+  LoadedMesh loaded = read_mesh(path, options);
   const MeshReadInfo& info = loaded.info;
   if (info.unused_vertices > 0) {
     std::cerr << path << ": note: " << info.unused_vertices
@@ -146,6 +146,18 @@ LoadedMesh load_mesh(const std::string& path, Confinement confinement) {
               << " faces on the same three vertices as an earlier face were dropped\n";
   }
   return loaded;
+}
+
+}  // namespace
+
+LoadedMesh load_mesh(const std::string& path, Confinement confinement) {
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  return load(path, {.keep_file = true, .companions = folder_resolver(folder, confinement)});
+}
+
+LoadedMesh load_geometry(const std::string& path) {
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  return load(path, {.companions = folder_resolver(folder, Confinement::Relative)});
 }
 
 void add_write_options(CLI::App& cmd, WriteOptions& options) {
