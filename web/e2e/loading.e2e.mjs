@@ -182,6 +182,12 @@ try {
   result.handle_painted_s = painted.at / 1000;
   log(`painted ${painted.handles} handle and ${painted.fixed} fixed vertices at ${(painted.at / 1000).toFixed(2)} s, phase ${painted.phase}`);
   check(painted.handles > 0 && painted.fixed > 0, `a handle and a fixed part were painted (${JSON.stringify(painted)})`);
+  // The counts show what was painted within a second, the basis computing or not.
+  const counted = await page.waitForFunction(() => {
+    const c = window.specdeformEditor.counts();
+    return document.getElementById('counts').textContent.includes(`fixed: ${c.fixed.toLocaleString()}`);
+  }, null, { timeout: 1000, polling: kPollMs }).then(() => true, () => false);
+  check(counted, `the panel counts the painted vertices as soon as they are painted ("${await page.textContent('#counts')}", phase ${painted.phase})`);
   // The first drag waits only for the basis and the selection (not the transfer's details).
   // (When the basis is ready before the fixed part is painted, the two strokes reach the server
   // one after the other: wait for both.)

@@ -437,13 +437,16 @@ export class Panel {
     this.renderStatus();
     const c = s.counts();
     $('hint').textContent = s.paintable ? this.nextStep(c) : '';
-    $('counts').textContent = r && editable
+    // The page's own counts from the first stroke on, painted while the basis computes too; the
+    // server's (free pieces, held vertices, modes per piece) once it is ready.
+    const served = !!r && editable;
+    $('counts').textContent = served || s.paintable
       ? `handles: ${c.handles.toLocaleString()} vertices in ${c.groups} group${c.groups === 1 ? '' : 's'} · ` +
         `fixed: ${c.fixed.toLocaleString()} · pinned: ${c.pinned.toLocaleString()}` +
-        (s.server?.free_pieces ? ` · ${s.server.free_pieces} piece(s) without handles ${s.ready?.settings.unconstrained === 'keep' ? 'held in place' : 'follow the surface'}` : '') +
-        (s.influenceHeld ? ` · ${s.influenceHeld.toLocaleString()} held beyond the region of influence (grey)` : '') +
+        (served && s.server?.free_pieces ? ` · ${s.server.free_pieces} piece(s) without handles ${s.ready?.settings.unconstrained === 'keep' ? 'held in place' : 'follow the surface'}` : '') +
+        (served && s.influenceHeld ? ` · ${s.influenceHeld.toLocaleString()} held beyond the region of influence (grey)` : '') +
         (s.viewer.hiddenCount ? ` · hidden: ${s.viewer.hiddenCount.toLocaleString()} (Alt+H shows them)` : '') +
-        ((s.server?.constrained_piece_modes?.length ?? 0) > 1 ? ` · modes per constrained piece: ${s.server!.constrained_piece_modes.join(', ')}` : '')
+        (served && (s.server?.constrained_piece_modes?.length ?? 0) > 1 ? ` · modes per constrained piece: ${s.server!.constrained_piece_modes.join(', ')}` : '')
       : '';
     this.renderNotes();
 
