@@ -13,6 +13,7 @@
 #include <unordered_set>
 
 #include "file_layout.h"
+#include "linalg/huge_pages.h"
 #include "linalg/parallel.h"
 #include "mesh_writers.h"
 #include "polygon_soup.h"
@@ -142,6 +143,7 @@ LoadedMesh build_mesh(PolygonSoup soup, const std::string& name) {
   std::vector<int> tris;  // 3 per triangle: k - 2 of a polygon of k corners
   const auto fans = std::ssize(soup.indices) - 2 * std::ptrdiff_t{soup.num_polygons()};
   tris.reserve(3 * std::max<std::ptrdiff_t>(fans, 0));
+  detail::advise_huge_pages(tris.data(), sizeof(int) * tris.capacity());
   info.face_to_file.reserve(tris.capacity() / 3);
   const std::vector<int> apex = fan_apexes(soup);
   for (int p = 0; p < soup.num_polygons(); ++p) {
@@ -293,7 +295,8 @@ std::string file_bytes(const std::filesystem::path& path, MeshFormat format) {
     const std::string_view piece(chunk.data(), static_cast<size_t>(file.gcount()));
     if (first && !ec) {
       if (format == MeshFormat::Stl) detail::check_stl_start(piece, size, path.string());
-      bytes.reserve(size);  // the buffer then takes the whole file (no regrowth)
+      bytes.reserve(size);  // the buffer then takes the whole file (no regrowth), on huge pages
+      detail::advise_huge_pages(bytes.data(), size);
     }
     first = false;
     bytes.append(piece);
