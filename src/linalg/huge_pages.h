@@ -9,11 +9,20 @@
 #include <cstddef>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 namespace specdeform::detail {
 
 // Asks for huge pages on the whole 2 MB pages inside [data, data + bytes), before it is written.
 void advise_huge_pages(void* data, std::size_t bytes);
+
+// A sparse matrix's entries (indices and values) as resizeNonZeros left them, advised so before
+// they are written (its outer index need not be filled yet: nonZeros() would read it).
+template <int Options>
+void advise_huge_pages(Eigen::SparseMatrix<double, Options, int>& A) {
+  advise_huge_pages(A.innerIndexPtr(), sizeof(int) * A.data().size());
+  advise_huge_pages(A.valuePtr(), sizeof(double) * A.data().size());
+}
 
 // An uninitialised rows x cols matrix, advised so.
 Eigen::MatrixXd large_matrix(Eigen::Index rows, Eigen::Index cols);

@@ -46,8 +46,7 @@ Eigen::SparseMatrix<double> renumbered(const Eigen::SparseMatrix<double>& A, con
   const int* to = P.indices().data();
   Eigen::SparseMatrix<double> B(A.rows(), n);
   B.resizeNonZeros(A.nonZeros());
-  advise_huge_pages(B.valuePtr(), sizeof(double) * A.nonZeros());
-  advise_huge_pages(B.innerIndexPtr(), sizeof(int) * A.nonZeros());
+  advise_huge_pages(B);
   int* start = B.outerIndexPtr();
   start[0] = 0;
   for (int j = 0; j < n; ++j) start[to[j] + 1] = A.outerIndexPtr()[j + 1] - A.outerIndexPtr()[j];
@@ -90,8 +89,7 @@ void permute_rows_back(const Permutation& P, Eigen::SparseMatrix<double, Eigen::
   for (Eigen::Index i = 0; i < n; ++i)
     out_start[i + 1] = out_start[i] + start[to[i] + 1] - start[to[i]];
   out.resizeNonZeros(out_start[n]);
-  advise_huge_pages(out.valuePtr(), sizeof(double) * out_start[n]);
-  advise_huge_pages(out.innerIndexPtr(), sizeof(int) * out_start[n]);
+  advise_huge_pages(out);
   split_in_two(n, [&](Eigen::Index begin, Eigen::Index end) {
     for (Eigen::Index i = begin; i < end; ++i) {
       const int from = start[to[i]], size = start[to[i] + 1] - from;

@@ -67,8 +67,7 @@ Eigen::SparseMatrix<double> cotan_stiffness(const TriangleMesh& mesh) {
   const detail::VertexRings rings = detail::vertex_rings(sound ? mesh : kept);
   Eigen::SparseMatrix<double> K(n, n);
   K.resizeNonZeros(static_cast<Eigen::Index>(rings.neighbour.size()) + n);
-  detail::advise_huge_pages(K.innerIndexPtr(), sizeof(int) * K.nonZeros());
-  detail::advise_huge_pages(K.valuePtr(), sizeof(double) * K.nonZeros());
+  detail::advise_huge_pages(K);
   int* outer = K.outerIndexPtr();
   int* inner = K.innerIndexPtr();
   double* value = K.valuePtr();

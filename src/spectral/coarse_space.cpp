@@ -58,8 +58,7 @@ void column_major(const Eigen::SparseMatrix<double, Eigen::RowMajor>& R, Sparse&
   const double* value = R.valuePtr();
   P.resize(n, N);
   P.resizeNonZeros(nnz);
-  advise_huge_pages(P.valuePtr(), sizeof(double) * nnz);
-  advise_huge_pages(P.innerIndexPtr(), sizeof(int) * nnz);
+  advise_huge_pages(P);
   int* start = P.outerIndexPtr();
   std::fill_n(start, N + 1, 0);
   for (int e = 0; e < nnz; ++e) ++start[column[e] + 1];
@@ -132,8 +131,7 @@ CoarseSpace partition_of_unity(const EdgeGraph& graph, const Sampling& farthest,
   start[0] = 0;
   for (int i = 0; i < n; ++i) start[i + 1] = start[i] + count[0][i] + count[1][i];
   R.resizeNonZeros(start[n]);
-  advise_huge_pages(R.valuePtr(), sizeof(double) * start[n]);
-  advise_huge_pages(R.innerIndexPtr(), sizeof(int) * start[n]);
+  advise_huge_pages(R);
   run_pair(
       [&] {
         for (int i = 0; i < n; ++i) count[0][i] = start[i];
