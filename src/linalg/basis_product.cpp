@@ -192,13 +192,15 @@ void add_basis_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
   add_factored_product(base, H, C, FloatRows{out.data(), out.outerStride()});
 }
 
-Eigen::MatrixXd factored_product(const FactoredBasis& H) {
+Eigen::MatrixXd factored_product(const FactoredBasis& H, Eigen::MatrixXd storage) {
   const auto& P = H.prolongation;
   const Eigen::Index m = H.coarse.cols();
   const Eigen::Index padded = (m + kChunk - 1) / kChunk * kChunk;
   RowMajor Z = RowMajor::Zero(H.coarse.rows(), padded);
   Z.leftCols(m) = H.coarse;
-  Eigen::MatrixXd out = large_matrix(P.rows(), m);
+  Eigen::MatrixXd out = storage.rows() == P.rows() && storage.cols() == m
+                            ? std::move(storage)
+                            : large_matrix(P.rows(), m);
   split_in_two(P.rows(), [&](Eigen::Index begin, Eigen::Index end) {
     prolongate_rows(P.outerIndexPtr(), P.innerIndexPtr(), P.valuePtr(), Z.data(), padded, m,
                     out.data(), P.rows(), begin, end);

@@ -33,7 +33,8 @@ void add_basis_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
 
 // H = P Z itself (n x m, column-major, on huge pages: linalg/huge_pages.h): per tile of 64 rows
 // and 16 columns each row's sums in registers, stored into H's columns a tile at a time, on two
-// threads.
-Eigen::MatrixXd factored_product(const FactoredBasis& H);
+// threads. Into `storage`'s memory where it is n x m (pages touched beforehand: touched_matrix),
+// else into a new matrix.
+Eigen::MatrixXd factored_product(const FactoredBasis& H, Eigen::MatrixXd storage = {});
 
 }  // namespace specdeform::detail

@@ -3,6 +3,7 @@
 #include <sys/mman.h>
 
 #include <cstdint>
+#include <cstring>
 
 namespace specdeform::detail {
 
@@ -21,6 +22,12 @@ void advise_huge_pages(void* data, std::size_t bytes) {
 Eigen::MatrixXd large_matrix(Eigen::Index rows, Eigen::Index cols) {
   Eigen::MatrixXd X(rows, cols);
   advise_huge_pages(X.data(), sizeof(double) * static_cast<std::size_t>(X.size()));
+  return X;
+}
+
+Eigen::MatrixXd touched_matrix(Eigen::Index rows, Eigen::Index cols) {
+  Eigen::MatrixXd X = large_matrix(rows, cols);
+  std::memset(X.data(), 0, sizeof(double) * static_cast<std::size_t>(X.size()));
   return X;
 }
 

@@ -27,4 +27,8 @@ void advise_huge_pages(Eigen::SparseMatrix<double, Options, int>& A) {
 // An uninitialised rows x cols matrix, advised so.
 Eigen::MatrixXd large_matrix(Eigen::Index rows, Eigen::Index cols);
 
+// The same with every page written once (zeros): the first touch's cost (the kernel finding and
+// zeroing each page) paid now, on a thread that has nothing else to do, not by the writer later.
+Eigen::MatrixXd touched_matrix(Eigen::Index rows, Eigen::Index cols);
+
 }  // namespace specdeform::detail

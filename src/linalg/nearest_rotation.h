@@ -8,8 +8,8 @@
 // and the right orientation by construction): 2-3 times faster than a Jacobi SVD. A^T A squares
 // A's condition number, so the closed form is checked: where A has rank below 2, or R^T A (the
 // symmetric factor) is not symmetric to 1e-10 of |A| (an ill-conditioned A, such as a cluster's
-// covariance on a mesh of slivers: eigenvalues 3e3 and 3e9, the closed form's R up to 70 degrees from
-// the identity), the Jacobi SVD decides.
+// covariance on a mesh of slivers: eigenvalues 3e3 and 3e9, the closed form's R up to 70 degrees
+// from the identity), the Jacobi SVD decides.
 #pragma once
 
 #include <Eigen/Core>

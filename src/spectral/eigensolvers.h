@@ -20,7 +20,9 @@ namespace specdeform::detail {
 
 struct Spectrum {
   Eigen::VectorXd lambda;
-  Eigen::MatrixXd H;  // empty where `factored` holds it
+  // The basis (n x m); where `factored` holds it, empty or memory for its product (n x m, its
+  // pages touched, contents undefined: linalg/basis_product.h factored_product).
+  Eigen::MatrixXd H;
   SolveStatus status = SolveStatus::Converged;
   int bands = 0, restarts = 0;
   long long solves = 0;

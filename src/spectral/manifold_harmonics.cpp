@@ -132,10 +132,11 @@ detail::Spectrum solve_connected(const Sparse& K, const Sparse& M_unit, const Sp
 ManifoldHarmonics harmonics_in_order(const Sparse& K, const Sparse& M, const Sparse* lengths,
                                      const ManifoldHarmonicsOptions& o);
 
-// A factored basis's H = P Z, formed once, in the numbering it is returned in.
+// A factored basis's H = P Z, formed once, in the numbering it is returned in (into the memory
+// the solver left in h.basis for it: detail::Spectrum::H).
 void prolongate(ManifoldHarmonics& h, const ManifoldHarmonicsOptions& o) {
   detail::report(o, 1.0, "prolongation");
-  h.basis = detail::factored_product(h.factored);
+  h.basis = detail::factored_product(h.factored, std::move(h.basis));
 }
 
 // Both overloads: `lengths` gives the multilevel solver's distances, or null. Meshes of

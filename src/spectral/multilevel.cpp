@@ -6,7 +6,8 @@
 //     block Krylov-Schur solver, its first m + 1 pairs (Z, Lambda; the last tells a truncated
 //     cluster);
 //  3. U = P Z: exactly M-orthonormal in the fine M (Z^T P^T M P Z = I) and U^T K U = Lambda,
-//     returned as its factors (the caller forms U once, in the mesh's numbering).
+//     returned as its factors (the caller forms U once, in the mesh's numbering, into the
+//     memory returned in Spectrum::H).
 // Measured on the armadillo (43k, m = 100): two Jacobi steps on the fine residuals and a
 // Rayleigh-Ritz halved the eigenvalue error of a Wendland bump at support 2 (17% to 8.8%) for 3.3
 // times the time; a wider, smoother bump did better for less (1.9%), so there is no fine step.
@@ -17,6 +18,8 @@
 #include <string>
 
 #include "linalg/galerkin_product.h"
+#include "linalg/huge_pages.h"
+#include "linalg/parallel.h"
 #include "specdeform/exceptions.h"
 #include "spectral/coarse_space.h"
 #include "spectral/eigensolvers.h"
@@ -32,7 +35,13 @@ Spectrum solve_multilevel(const Sparse& K, const Sparse& M, const Sparse& length
   report(o, 0.0, "sampling");
   const EdgeGraph graph = edge_graph(lengths);
   const int samples = std::max(p.multilevel_min_samples, p.multilevel_samples_per_mode * m);
-  const Sampling farthest = farthest_points(graph, std::clamp(samples, 1, graph.size()));
+  // H = P Z is formed last, into fresh memory whose first touch costs its writer about as much
+  // as the product (the kernel zeroing 553 MB at 692k vertices: 0.4-0.5 s on a virtual
+  // machine): touched now, on the core the serial sampling leaves idle.
+  Sampling farthest;
+  Eigen::MatrixXd storage;
+  run_pair([&] { farthest = farthest_points(graph, std::clamp(samples, 1, graph.size())); },
+           [&] { storage = touched_matrix(K.rows(), m); });
   report(o, 0.03, "coarse space");
   CoarseSpace coarse = partition_of_unity(graph, farthest, p.multilevel_support);
   const Sparse& P = coarse.prolongation;
@@ -53,6 +62,7 @@ Spectrum solve_multilevel(const Sparse& K, const Sparse& M, const Sparse& length
   };
   ManifoldHarmonics h = compute_manifold_harmonics(Kc, Mc, co);
   Spectrum out;
+  out.H.swap(storage);
   out.factored.prolongation.swap(coarse.rows);
   out.factored.prolongation.makeCompressed();
   out.factored.coarse = h.basis.leftCols(m);

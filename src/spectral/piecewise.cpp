@@ -101,7 +101,9 @@ Spectrum solve_by_piece(const Sparse& K, const Sparse& M, const Sparse* lengths,
                        lengths ? &piece_lengths : nullptr, piece);
     for (const int v : index[c]) local[v] = -1;
     done += vertices[c];
-    if (!s.factored.empty()) s.H = factored_product(s.factored);  // pieces are gathered into one H
+    if (!s.factored.empty()) {  // pieces are gathered into one H
+      s.H = factored_product(s.factored, std::move(s.H));
+    }
     // From the piece's unit-area scale to M's: K h = (lambda / a) M h, h^T M h = a.
     s.lambda /= area[c];
     s.H /= std::sqrt(area[c]);

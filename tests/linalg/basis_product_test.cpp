@@ -60,6 +60,13 @@ TEST(BasisProduct, FactoredMatchesTheDenseBasis) {
     f.coarse = Eigen::MatrixXd::Random(N, 13);
     const Eigen::MatrixXd H = f.prolongation * f.coarse;
     EXPECT_LT((detail::factored_product(f) - H).cwiseAbs().maxCoeff(), 1e-12) << n;
+    Eigen::MatrixXd storage = Eigen::MatrixXd::Constant(n, 13, 7.0);  // H's memory, reused
+    const double* memory = storage.data();
+    const Eigen::MatrixXd into = detail::factored_product(f, std::move(storage));
+    EXPECT_EQ(into.data(), memory) << n;
+    EXPECT_LT((into - H).cwiseAbs().maxCoeff(), 1e-12) << n;
+    const Eigen::MatrixXd beside = detail::factored_product(f, Eigen::MatrixXd::Zero(n + 1, 13));
+    EXPECT_LT((beside - H).cwiseAbs().maxCoeff(), 1e-12) << n;  // not H's size: a new matrix
     const Eigen::MatrixX3d base = Eigen::MatrixX3d::Random(n, 3),
                            C = Eigen::MatrixX3d::Random(13, 3);
     const Eigen::MatrixX3d expected = base + H * C;

@@ -13,8 +13,9 @@
 namespace specdeform::detail {
 namespace {
 
-// The kilobytes of huge pages in the mapping that holds `address` (/proc/self/smaps).
-long huge_kilobytes_at(const void* address) {
+// A field's kilobytes (e.g. "AnonHugePages:", "Rss:") of the mapping that holds `address`
+// (/proc/self/smaps).
+long kilobytes_at(const void* address, const std::string& field) {
   const auto at = reinterpret_cast<std::uintptr_t>(address);
   std::ifstream smaps("/proc/self/smaps");
   std::string line;
@@ -25,8 +26,8 @@ long huge_kilobytes_at(const void* address) {
     std::istringstream range(line);
     if (range >> std::hex >> begin >> dash >> end && dash == '-') {
       inside = begin <= at && at < end;
-    } else if (inside && line.rfind("AnonHugePages:", 0) == 0) {
-      return std::stol(line.substr(14));
+    } else if (inside && line.rfind(field, 0) == 0) {
+      return std::stol(line.substr(field.size()));
     }
   }
   return -1;
@@ -47,7 +48,19 @@ TEST(HugePages, ALargeMatrixIsOnHugePages) {
   X.setConstant(1.0);
   EXPECT_EQ(X.sum(), 8.0 * (1 << 20));
   if (!kernel_lends_on_request()) GTEST_SKIP() << "transparent huge pages are off";
-  EXPECT_GT(huge_kilobytes_at(X.data() + X.size() / 2), 0);
+  EXPECT_GT(kilobytes_at(X.data() + X.size() / 2, "AnonHugePages:"), 0);
+}
+
+// A touched matrix is zeros, its memory resident before anything is written to it.
+TEST(HugePages, ATouchedMatrixIsResidentBeforeItIsWritten) {
+  const Eigen::MatrixXd X = touched_matrix(1 << 20, 8);  // 64 MB
+  ASSERT_EQ(X.rows(), 1 << 20);
+  ASSERT_EQ(X.cols(), 8);
+  EXPECT_EQ(X.cwiseAbs().maxCoeff(), 0.0);
+  const double* middle = X.data() + X.size() / 2;  // in the advised part's own mapping
+  EXPECT_GE(kilobytes_at(middle, "Rss:"), kilobytes_at(middle, "Size:") - 4);
+  const Eigen::MatrixXd untouched = large_matrix(1 << 20, 8);
+  EXPECT_LT(kilobytes_at(untouched.data() + untouched.size() / 2, "Rss:"), 8 << 10);
 }
 
 TEST(HugePages, AdviceOnAnyRangeIsHarmless) {
