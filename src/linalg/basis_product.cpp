@@ -125,8 +125,7 @@ void add_factored_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
 
 // H = P Z's rows [begin, end) into H (column-major, leading dimension n), Z row-major with
 // `padded` columns (zeros past m): per tile of kTile rows and chunk of kChunk columns, each row's
-// kChunk sums kept in registers over its entries of P (in their order, as a plain sum would
-// take them), then stored a column of the tile at a time.
+// kChunk sums kept in registers, then stored a column of the tile at a time.
 constexpr int kTile = 64;
 constexpr int kChunk = 16;
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -138,12 +137,8 @@ __attribute__((target_clones("avx2", "default"))) void prolongate_rows(
     const int rows = static_cast<int>(std::min<Eigen::Index>(kTile, end - first));
     for (Eigen::Index c = 0; c < m; c += kChunk) {
       for (int r = 0; r < rows; ++r) {
-        double sum[kChunk] = {};
-        for (int e = start[first + r]; e < start[first + r + 1]; ++e) {
-          const double v = value[e];
-          const double* z = Z + column[e] * padded + c;
-          for (int q = 0; q < kChunk; ++q) sum[q] += v * z[q];
-        }
+        double sum[kChunk];
+        sparse_row_product<kChunk>(start, column, value, Z + c, padded, first + r, sum);
         for (int q = 0; q < kChunk; ++q) tile[q][r] = sum[q];
       }
       const int width = static_cast<int>(std::min<Eigen::Index>(kChunk, m - c));

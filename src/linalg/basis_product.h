@@ -31,6 +31,21 @@ void add_basis_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
 void add_basis_product(const Eigen::MatrixX3d& base, const FactoredBasis& H,
                        const Eigen::MatrixX3d& C, Eigen::Ref<FloatVertices> out);
 
+// Row i of P Z over W columns of Z: sum[q] = sum_e P_ie Z(column_e, q), Z row-major with
+// `stride` entries a row (from the first column wanted), P's entries in their order (as a plain
+// sum takes them). The kernel of the product below and of the basis's residual check, inlined
+// into each (and vectorised there: the sums stay in registers).
+template <int W>
+inline void sparse_row_product(const int* start, const int* column, const double* value,
+                               const double* Z, Eigen::Index stride, Eigen::Index i, double* sum) {
+  for (int q = 0; q < W; ++q) sum[q] = 0.0;
+  for (int e = start[i]; e < start[i + 1]; ++e) {
+    const double v = value[e];
+    const double* z = Z + stride * Eigen::Index{column[e]};
+    for (int q = 0; q < W; ++q) sum[q] += v * z[q];
+  }
+}
+
 // H = P Z itself (n x m, column-major, on huge pages: linalg/huge_pages.h): per tile of 64 rows
 // and 16 columns each row's sums in registers, stored into H's columns a tile at a time, on two
 // threads. Into `storage`'s memory where it is n x m (pages touched beforehand: touched_matrix),

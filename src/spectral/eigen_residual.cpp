@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "linalg/basis_product.h"
 #include "linalg/huge_pages.h"
 #include "linalg/parallel.h"
 
@@ -80,12 +81,8 @@ __attribute__((target_clones("avx2", "default"))) void gather_rows(
     const int* start, const int* column, const double* value, const double* Z, Eigen::Index begin,
     Eigen::Index end, double* block, double* extreme) {
   for (Eigen::Index i = begin; i < end; ++i) {
-    double row[kColumns] = {};
-    for (int e = start[i]; e < start[i + 1]; ++e) {
-      const double v = value[e];
-      const double* z = Z + kColumns * Eigen::Index{column[e]};
-      for (int q = 0; q < kColumns; ++q) row[q] += v * z[q];
-    }
+    double row[kColumns];
+    sparse_row_product<kColumns>(start, column, value, Z, kColumns, i, row);
     for (int q = 0; q < kColumns; ++q) {
       block[kColumns * i + q] = row[q];
       if (std::abs(row[q]) > std::abs(extreme[q])) extreme[q] = row[q];
