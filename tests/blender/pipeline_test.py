@@ -327,6 +327,13 @@ def check_edit_mode():
     bm = bmesh.from_edit_mesh(obj.data)
     shown = np.array([v.co for v in bm.verts])
     assert np.abs(shown - rest).max() <= 1e-6, "Edit Mode does not show the rest shape"
+    # Both of show_rest's ways: a rest the saved one does not hold is set from the array itself,
+    # and the saved one from its attribute.
+    other = (1.5 * rest).astype(np.float32)
+    support.editing.show_rest(obj, other)
+    assert np.abs(np.array([v.co for v in bm.verts]) - other).max() <= 1e-6, "not the rest given"
+    support.editing.show_rest(obj)
+    assert np.abs(np.array([v.co for v in bm.verts]) - rest).max() <= 1e-6, "not the saved rest"
     free = int(np.argmin(np.abs(rest[:, 0] - 2.0) + np.abs(rest[:, 2] - rest[:, 2].max())))
     bm.verts.ensure_lookup_table()
     v = bm.verts[free]

@@ -14,7 +14,8 @@ import numpy as np  # noqa: E402
 from mathutils import Matrix  # noqa: E402
 
 import specdeform_blender  # noqa: E402
-from specdeform_blender import binding, library, mesh_helpers  # noqa: E402, F401 (for the tests)
+# For the tests:
+from specdeform_blender import binding, editing, library, mesh_helpers  # noqa: E402, F401
 
 SKIP = 77  # CTest's SKIP_RETURN_CODE
 
