@@ -33,6 +33,7 @@
 #include <nlohmann/json.hpp>
 
 #include "editor_server.h"
+#include "huge_pages_start.h"
 #include "protocol.h"
 #include "specdeform/deform/scene.h"
 
@@ -198,6 +199,7 @@ net::awaitable<void> run_client(uint16_t port, sd::Selection selection, std::vec
 }  // namespace
 
 int main(int argc, char** argv) {
+  specdeform::apps::restart_with_huge_pages(argv);  // as the editor's server runs
   std::filesystem::path mesh_path =
       std::filesystem::path(SPECDEFORM_SHARED_DIR) / "meshes/models/armadillo.obj";
   double seconds = 4, hz = 60;

@@ -3,10 +3,7 @@
 // Exit codes: 0 success, 1 bad input (file, scene), 2 bad arguments, 3 numerical failure (and,
 // as a last resort, any other error). Errors are one line on stderr; a command run with --json
 // also prints {"error": message, "exit_code": code} on stdout.
-#include <unistd.h>
-
 #include <algorithm>
-#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <iostream>
@@ -18,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common.h"
+#include "huge_pages_start.h"
 #include "specdeform/exceptions.h"
 #include "specdeform/version.h"
 
@@ -40,32 +38,10 @@ int fail(const CLI::App& app, int argc, char** argv, int code, const char* prefi
   return code;
 }
 
-// The CLI owns its process, so it has glibc's malloc ask the kernel for transparent huge pages
-// on its large blocks (the tunable glibc.malloc.hugetlb=1, read only when a program starts: the
-// program starts itself once more with it). Under a hypervisor the first touch of a 4 KB page
-// costs about 8.5 us, and every stage's fresh arrays, CHOLMOD's factor included, paid it: the 692k
-// armadillo's deform took 16.7 s without them and 9.5 s with them, the 2.77M one 100 s and 47 s,
-// at the same peak memory (docs/results.md, "Huge pages for the whole program"). A
-// GLIBC_TUNABLES that names the tunable (=0 to turn it off) is kept as it is; a glibc without the
-// tunable ignores it, and a failed restart carries on as it is.
-void restart_with_huge_pages(char** argv) {
-#if defined(__GLIBC__) && defined(__linux__)
-  const char* tunables = std::getenv("GLIBC_TUNABLES");
-  if (tunables != nullptr && std::strstr(tunables, "glibc.malloc.hugetlb") != nullptr) return;
-  const std::string value = (tunables != nullptr && *tunables != '\0')
-                                ? std::string(tunables) + ":glibc.malloc.hugetlb=1"
-                                : std::string("glibc.malloc.hugetlb=1");
-  if (setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0) return;
-  execv("/proc/self/exe", argv);
-#else
-  (void)argv;
-#endif
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  restart_with_huge_pages(argv);
+  specdeform::apps::restart_with_huge_pages(argv);
   CLI::App app{"specdeform: detail-preserving spectral deformation of triangle meshes",
                "specdeform"};
   app.require_subcommand(1);
