@@ -167,5 +167,23 @@ expect 1 "$bin" edit "$tmp/missing.obj" --port 0
 expect 1 "$bin" edit --assets "$tmp/nowhere" --port 0
 expect 1 "$bin" edit --host not-an-address --port 0 --assets "$tmp"
 expect 2 "$bin" edit --port 70000
+# The program runs with glibc's huge pages for malloc (apps/huge_pages_start.h): it starts itself
+# again with glibc.malloc.hugetlb=1 in GLIBC_TUNABLES, and a value the user set stays. Read from
+# the running editor server's environment (where glibc cuts a list of several tunables at its
+# first ':' as it parses it, so other tunables kept are not seen there).
+tunables_of() {  # tunables_of [VAR=VALUE...]: the server's GLIBC_TUNABLES
+  env -u GLIBC_TUNABLES "$@" "$bin" edit --port 0 --no-cache --assets "$tmp" >"$tmp/serve" 2>&1 &
+  local pid=$! i
+  for i in $(seq 100); do grep -q http "$tmp/serve" && break; sleep 0.1; done
+  tr '\0' '\n' </proc/$pid/environ | sed -n 's/^GLIBC_TUNABLES=//p'
+  kill $pid; wait $pid 2>/dev/null
+}
+if ldd --version 2>&1 | grep -qiE 'glibc|gnu libc'; then
+  echo '<html></html>' >"$tmp/index.html"
+  [ "$(tunables_of)" = glibc.malloc.hugetlb=1 ] ||
+    { echo "FAIL: the program runs without huge pages: '$(tunables_of)'"; fails=$((fails + 1)); }
+  [ "$(tunables_of GLIBC_TUNABLES=glibc.malloc.hugetlb=0)" = glibc.malloc.hugetlb=0 ] ||
+    { echo "FAIL: the user's hugetlb=0 not kept"; fails=$((fails + 1)); }
+fi
 [ "$fails" = 0 ] && echo "cli tests passed"
 exit "$fails"
