@@ -44,26 +44,27 @@ def show_rest(obj, rest=None):
     bmesh.update_edit_mesh(obj.data, loop_triangles=False, destructive=False)
 
 
-def _layer_holds(bm, layer, rest):
-    """Whether the edit mesh's `layer` holds `rest` (float32 (n, 3)), on about 64 vertices spread
-    over it (every step-th: a lookup table would take 0.2 s at 692k): the saved rest is written
-    with each binding's rest, so it differs everywhere or nowhere."""
-    if len(bm.verts) != len(rest):
+def _sample_holds(bm, read, co):
+    """Whether read(v) is co's row for about 64 vertices v spread over the edit mesh (every
+    step-th: a lookup table would take 0.2 s at 692k vertices); false where the counts differ."""
+    if len(bm.verts) != len(co):
         return False
-    step = max(1, len(rest) // 64)
-    sample = [v[layer] for v in itertools.islice(bm.verts, 0, None, step)]
-    return np.array_equal(np.array(sample, np.float32), np.asarray(rest, np.float32)[::step])
+    step = max(1, len(co) // 64)
+    sample = [read(v) for v in itertools.islice(bm.verts, 0, None, step)]
+    return np.array_equal(np.array(sample, np.float32), np.asarray(co, np.float32)[::step])
+
+
+def _layer_holds(bm, layer, rest):
+    """Whether the edit mesh's `layer` holds `rest` (float32 (n, 3)), on a sample: the saved rest
+    is written with each binding's rest, so it differs everywhere or nowhere."""
+    return _sample_holds(bm, lambda v: v[layer], rest)
 
 
 def _edit_mesh_shows(obj, co):
     """Whether the edit mesh's vertices are at `co`: a sample first (reading them all is a loop,
     half a second at 692k)."""
     bm = bmesh.from_edit_mesh(obj.data)
-    if len(bm.verts) != len(co):
-        return False
-    bm.verts.ensure_lookup_table()
-    sample = np.unique(np.linspace(0, len(co) - 1, 64).astype(int))
-    if not np.array_equal(np.array([bm.verts[i].co for i in sample], np.float32), co[sample]):
+    if not _sample_holds(bm, lambda v: v.co, co):
         return False
     return np.array_equal(np.array([v.co for v in bm.verts], np.float32).reshape(-1, 3), co)
 
