@@ -203,19 +203,35 @@ std::string encode_file(const NamedFile& file, Tag tag) {
   return w.take();
 }
 
-std::string encode_mesh_message(const TriangleMesh& mesh) {
-  Writer w;
-  w.reserve(12 + 12 * (mesh.V.rows() + mesh.F.rows()));
-  w.put(static_cast<uint32_t>(Tag::Mesh));
-  w.put(static_cast<uint32_t>(mesh.V.rows()));
-  w.put(static_cast<uint32_t>(mesh.F.rows()));
-  for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
-    for (int k = 0; k < 3; ++k) w.put(static_cast<float>(mesh.V(i, k)));
-  }
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
-    for (int k = 0; k < 3; ++k) w.put(static_cast<uint32_t>(mesh.F(f, k)));
-  }
-  return w.take();
+std::vector<std::string> encode_mesh_parts(const TriangleMesh& mesh, uint32_t part_items) {
+  const auto n = static_cast<uint32_t>(mesh.V.rows());
+  const auto triangles = static_cast<uint32_t>(mesh.F.rows());
+  std::vector<std::string> parts;
+  const auto add = [&](uint32_t kind, uint32_t size, const auto& rows) {
+    for (uint32_t first = 0; first == 0 || first < size; first += part_items) {
+      const uint32_t count = std::min(part_items, size - first);
+      Writer w;
+      w.reserve(24 + 12 * count);
+      for (uint32_t field : {static_cast<uint32_t>(Tag::Mesh), n, triangles, kind, first, count}) {
+        w.put(field);
+      }
+      for (uint32_t i = first; i < first + count; ++i) {
+        for (int k = 0; k < 3; ++k) w.put(rows(i, k));
+      }
+      parts.push_back(w.take());
+    }
+  };
+  add(0, n, [&](uint32_t i, int k) { return static_cast<float>(mesh.V(i, k)); });
+  add(1, triangles, [&](uint32_t f, int k) { return static_cast<uint32_t>(mesh.F(f, k)); });
+  return parts;
+}
+
+bool starts_mesh(std::string_view message) {
+  uint32_t kind = 1, first = 1;
+  if (message_tag(message) != Tag::Mesh || message.size() < 24) return false;
+  std::memcpy(&kind, message.data() + 12, 4);
+  std::memcpy(&first, message.data() + 16, 4);
+  return kind == 0 && first == 0;
 }
 
 std::string encode_preview(const PreviewMesh& preview) {

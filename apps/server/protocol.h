@@ -19,8 +19,13 @@
 //   6 companion    the same layout as 3: a file the next mesh file names (an MTL, a texture, a
 //                  .gltf's buffer), by that name; sent before the mesh file
 // Server -> browser
-//   101 mesh       u32 tag | u32 n | u32 triangles T | f32 positions (3 n) | u32 corners (3 T);
-//                  a mesh being opened is sent before its basis is computed
+//   101 mesh part  u32 tag | u32 n | u32 triangles T | u32 kind (0: positions, 1: triangles) |
+//                  u32 first vertex or triangle | u32 count C | f32 positions (3 C) or u32
+//                  corners (3 C): the mesh in parts of at most kMeshPartItems, its positions
+//                  first, so that the page counts the bytes and draws the triangles as they
+//                  come; a mesh being opened is sent before its basis is computed. The
+//                  server gathers the parts and the page fetches them over HTTP
+//                  (editor_server.h), not over the socket
 //   102 frame      u32 tag | u32 seq | u32 n | u32 view (bit 0: smooth base, bit 1: preview,
 //                  bit 2: the smooth base folded, details added as displacements there) |
 //                  f32 reduced solve, inverse transform, detail, total (ms) |
@@ -144,7 +149,12 @@ NamedFile decode_file(std::string_view message);
 std::string encode_selection(const GroupSelection& selection, Tag tag = Tag::SelectionResult);
 std::string encode_frame(const FrameRequest& frame);
 std::string encode_file(const NamedFile& file, Tag tag = Tag::File);
-std::string encode_mesh_message(const TriangleMesh& mesh);
+// The mesh's 101 messages, in order: positions [0, n), then triangles [0, T).
+inline constexpr uint32_t kMeshPartItems = 1u << 16;
+std::vector<std::string> encode_mesh_parts(const TriangleMesh& mesh,
+                                           uint32_t part_items = kMeshPartItems);
+// Whether a 101 message is a mesh's first part (its positions from vertex 0).
+bool starts_mesh(std::string_view message);
 std::string encode_preview(const PreviewMesh& preview);
 std::string encode_appearance(const Appearance& appearance);
 std::string encode_texture(uint32_t material, std::string_view mime, std::string_view image);

@@ -2,6 +2,7 @@
 
 #include <utility>  // before Boost.Asio, whose awaitable.hpp uses std::exchange
 
+#include <cstring>
 #include <fstream>
 #include <thread>
 
@@ -111,6 +112,33 @@ TEST_F(EditorServerTest, ServesOnlyTheBuiltAssets) {
   EXPECT_EQ(get("/", "evil.example:80").result(), http::status::forbidden);
   EXPECT_EQ(get("/", "", http::verb::post).result(), http::status::method_not_allowed);
   EXPECT_EQ(get("/", "localhost:" + std::to_string(server_->port())).result(), http::status::ok);
+}
+
+// The mesh's parts come over HTTP, as the socket's notice says: positions first, then
+// triangles; a replaced mesh is not served.
+TEST_F(EditorServerTest, ServesTheOpenMeshAsItsNoticeSays) {
+  auto ws = connect(own_origin());
+  const nlohmann::json notice = read_until(*ws, "mesh");
+  const std::string id = std::to_string(notice["id"].get<uint64_t>());
+  const auto res = get("/mesh/" + id);
+  ASSERT_EQ(res.result(), http::status::ok);
+  EXPECT_EQ(res[http::field::content_type], "application/octet-stream");
+  const std::string& body = res.body();
+  ASSERT_EQ(body.size(), notice["bytes"].get<size_t>());
+  ASSERT_TRUE(starts_mesh(body));
+  std::vector<uint32_t> header(6);
+  size_t at = 0, vertices = 0, triangles = 0;
+  for (; at + 24 <= body.size(); at += 24 + 12 * header[5]) {
+    std::memcpy(header.data(), body.data() + at, 24);
+    EXPECT_EQ(header[0], static_cast<uint32_t>(Tag::Mesh));
+    (header[3] == 0 ? vertices : triangles) += header[5];
+  }
+  EXPECT_EQ(at, body.size());
+  EXPECT_EQ(vertices, 162u);
+  EXPECT_EQ(triangles, 320u);
+  EXPECT_EQ(get("/mesh/" + std::to_string(notice["id"].get<uint64_t>() + 1)).result(),
+            http::status::not_found);
+  EXPECT_EQ(get("/mesh/" + id, "evil.example:80").result(), http::status::forbidden);
 }
 
 TEST_F(EditorServerTest, RefusesWebSocketsFromOtherOrigins) {

@@ -96,15 +96,22 @@ class EditorSessionTest : public ::testing::Test {
     return nullptr;
   }
 
-  // The rest shape frames are sent against: the last mesh message's (a pose changes it).
+  // The rest shape frames are sent against: the last mesh's parts' (a pose changes it).
   Vertices current_rest() {
-    const std::string* m = last_binary(Tag::Mesh);
-    if (!m) return rest_;
+    auto start = std::find_if(sent_.rbegin(), sent_.rend(),
+                              [](const Sent& m) { return m.binary && starts_mesh(m.data); });
+    if (start == sent_.rend()) return rest_;
     Vertices V(rest_.rows(), 3);
-    for (Eigen::Index i = 0; i < 3 * V.rows(); ++i) {
-      float x = 0;
-      std::memcpy(&x, m->data() + 12 + 4 * i, 4);
-      V(i / 3, i % 3) = x;
+    for (auto it = std::prev(start.base()); it != sent_.end(); ++it) {
+      if (!it->binary || message_tag(it->data) != Tag::Mesh) continue;
+      uint32_t header[6];
+      std::memcpy(header, it->data.data(), sizeof header);
+      if (header[3] != 0) continue;  // triangles
+      for (uint32_t i = 0; i < 3 * header[5]; ++i) {
+        float x = 0;
+        std::memcpy(&x, it->data.data() + 24 + 4 * i, 4);
+        V(header[4] + i / 3, i % 3) = x;
+      }
     }
     return V;
   }
@@ -498,11 +505,8 @@ TEST_F(EditorSessionTest, ApplyPoseMakesTheResultTheRestShape) {
   sent_.clear();
   session_->handle(false, R"({"type": "apply_pose"})");
   ASSERT_TRUE(last_binary(Tag::Mesh));
-  uint32_t n = 0;
-  std::memcpy(&n, last_binary(Tag::Mesh)->data() + 4, 4);
-  float x = 0;
-  std::memcpy(&x, last_binary(Tag::Mesh)->data() + 12 + 12 * selection_.handles[0][0], 4);
-  EXPECT_NEAR(x, posed(selection_.handles[0][0], 0), 1e-6);
+  EXPECT_NEAR(current_rest()(selection_.handles[0][0], 0), posed(selection_.handles[0][0], 0),
+              1e-6);
   const Json ready = last_text("ready");
   EXPECT_EQ(ready["pose"], 1);
   EXPECT_NE(ready["basis"]["source"], "cache");
@@ -631,7 +635,8 @@ TEST(EditorSessionOpen, SendsTheMeshBeforeItsBasis) {
   std::vector<std::string> order;
   EditorSession session(EditorConfig{.modes = 20}, [&](bool binary, std::string data) {
     order.push_back(
-        binary ? std::to_string(static_cast<uint32_t>(message_tag(data)))
+        binary ? (starts_mesh(data) ? "mesh"
+                                    : std::to_string(static_cast<uint32_t>(message_tag(data))))
                : Json::parse(data)["type"].get<std::string>() +
                      (data.find("setting up the solver") != std::string::npos ? " setup" : ""));
   });
@@ -642,7 +647,8 @@ TEST(EditorSessionOpen, SendsTheMeshBeforeItsBasis) {
   const auto at = [&](const std::string& what) {
     return std::find(order.begin(), order.end(), what) - order.begin();
   };
-  EXPECT_EQ(order.front(), std::to_string(static_cast<uint32_t>(Tag::Mesh)));
+  EXPECT_EQ(order.front(), "mesh");
+  EXPECT_EQ(order[1], std::to_string(static_cast<uint32_t>(Tag::Mesh)));  // its triangles
   EXPECT_LT(at("progress"), at("progress setup"));
   EXPECT_LT(at("progress setup"), at("ready"));
   EXPECT_EQ(std::count(order.begin(), order.end(), order.front()), 1);  // sent once
@@ -668,7 +674,7 @@ TEST(EditorSessionOpen, ACancelledOpenSendsTheOpenMeshBack) {
                                    Tag::MeshFile));
   std::vector<uint32_t> vertices;
   for (const Sent& m : sent) {
-    if (m.binary && message_tag(m.data) == Tag::Mesh) {
+    if (m.binary && starts_mesh(m.data)) {
       vertices.push_back(0);
       std::memcpy(&vertices.back(), m.data.data() + 4, 4);
     }

@@ -98,9 +98,26 @@ TEST(Protocol, MeshAndFrameResultLayouts) {
   TriangleMesh m{Vertices(3, 3), Faces(1, 3)};
   m.V << 0, 0, 0, 1, 0, 0, 0, 1, 0;
   m.F << 0, 1, 2;
-  const std::string mesh = encode_mesh_message(m);
-  EXPECT_EQ(mesh.size(), 12u + 36u + 12u);
-  EXPECT_EQ(message_tag(mesh), Tag::Mesh);
+  // Parts of two: positions of vertices 0-1 and 2, then the triangle.
+  const std::vector<std::string> parts = encode_mesh_parts(m, 2);
+  ASSERT_EQ(parts.size(), 3u);
+  const std::vector<std::vector<uint32_t>> headers{
+      {101, 3, 1, 0, 0, 2}, {101, 3, 1, 0, 2, 1}, {101, 3, 1, 1, 0, 1}};
+  for (size_t p = 0; p < parts.size(); ++p) {
+    std::vector<uint32_t> header(6);
+    std::memcpy(header.data(), parts[p].data(), 24);
+    EXPECT_EQ(header, headers[p]);
+    EXPECT_EQ(parts[p].size(), 24u + 12u * header[5]);
+    EXPECT_EQ(starts_mesh(parts[p]), p == 0);
+  }
+  float y = 0;
+  std::memcpy(&y, parts[0].data() + 24 + 16, 4);  // vertex 1's y
+  EXPECT_EQ(y, 0.0f);
+  std::memcpy(&y, parts[1].data() + 24 + 4, 4);  // vertex 2's y
+  EXPECT_EQ(y, 1.0f);
+  uint32_t corner = 0;
+  std::memcpy(&corner, parts[2].data() + 24 + 8, 4);
+  EXPECT_EQ(corner, 2u);
   Vertices moved = m.V;
   moved(1, 0) += 0.5;
   moved(2, 2) -= 0.25;

@@ -2,15 +2,21 @@
 // vertex normals (of the full mesh and of the coarse preview), the full frames' area, volume
 // and stretch against the input (measures.ts), and the brush (the vertices within a radius, along the surface or in space), so that
 // the page keeps taking pointer events while a large mesh is processed.
+import { MeshArrival } from './arrival';
 import { Brush } from './brush';
 import { groupNormals } from './look';
 import { Measures, MeshMeasures } from './measures';
 import { vertexNormals } from './normals';
+import type { MeshPart } from './protocol';
 
 export type Slot = 'full' | 'preview';
 
 export type WorkerRequest =
-  | { kind: 'mesh'; slot: Slot; indices: Uint32Array; rest: Float32Array }
+  // The full mesh comes a part at a time, as the page receives it; `adopt` makes the last one
+  // that came whole the full slot's.
+  | { kind: 'part'; part: MeshPart }
+  | { kind: 'adopt' }
+  | { kind: 'preview'; indices: Uint32Array; rest: Float32Array } // the coarse mesh of drags
   // The full mesh's file look: render vertices (their mesh vertex and normal group) and triangles.
   | { kind: 'look'; vertex: Uint32Array; group: Uint32Array; indices: Uint32Array }
   | { kind: 'frame'; slot: Slot; seq: number; scale: number; displacements: Int16Array }
@@ -40,19 +46,26 @@ interface Look {
 }
 
 const meshes: Partial<Record<Slot, Mesh>> = {};
+const arrival = new MeshArrival();
 let look: Look | null = null;
 const post = (reply: WorkerReply, transfer: Transferable[]) =>
   (self as unknown as Worker).postMessage(reply, transfer);
 
 self.onmessage = (e: MessageEvent<WorkerRequest>) => {
   const m = e.data;
-  if (m.kind === 'look') {
+  if (m.kind === 'part') {
+    arrival.add(m.part);
+  } else if (m.kind === 'adopt') {
+    if (!arrival.whole) return;
+    const { indices, positions } = arrival.mesh!;
+    look = null; // its look, if any, follows
+    meshes.full = { indices, rest: positions, brush: null, measures: null, positions: positions.slice() };
+  } else if (m.kind === 'look') {
     let groups = 0;
     for (const g of m.group) groups = Math.max(groups, g + 1);
     look = { vertex: m.vertex, group: m.group, indices: m.indices, sums: new Float32Array(3 * groups) };
-  } else if (m.kind === 'mesh') {
-    if (m.slot === 'full') look = null; // its look, if any, follows
-    meshes[m.slot] = { indices: m.indices, rest: m.rest, brush: null, measures: null, positions: m.rest.slice() };
+  } else if (m.kind === 'preview') {
+    meshes.preview = { indices: m.indices, rest: m.rest, brush: null, measures: null, positions: m.rest.slice() };
   } else if (m.kind === 'frame') {
     const mesh = meshes[m.slot];
     if (!mesh || mesh.rest.length !== m.displacements.length) return;

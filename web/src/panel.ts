@@ -22,6 +22,9 @@ const HINTS: Record<Tool, string> = {
 
 const MESH_FILE = /\.(obj|off|ply|stl|gltf|glb)$/i;
 const NAVIGATION_KEY = 'specdeform.navigation';
+// Counts as the page's locale writes them; made at load: the first number formatted otherwise
+// waits for the locale's data (60 ms, while a large mesh is taken).
+const numbers = new Intl.NumberFormat();
 const kOrbitStep = 15; // degrees a numpad 4, 6, 8 or 2 turns the view (Blender's default)
 
 // Keys typed into a text field stay there; every other control hands the keyboard back to the
@@ -73,8 +76,8 @@ export class Panel {
     const c = this.s.counts();
     if (c.handles + c.fixed + c.pinned === 0 && !this.s.server?.undo) return Promise.resolve(true);
     const dialog = $<HTMLDialogElement>('confirm');
-    $('confirm-text').textContent = `${action} replaces the current edit (${c.handles.toLocaleString()} handle, ` +
-      `${c.fixed.toLocaleString()} fixed and ${c.pinned.toLocaleString()} pinned vertices, and its undo history). ` +
+    $('confirm-text').textContent = `${action} replaces the current edit (${numbers.format(c.handles)} handle, ` +
+      `${numbers.format(c.fixed)} fixed and ${numbers.format(c.pinned)} pinned vertices, and its undo history). ` +
       'Export the scene first to keep it.';
     dialog.showModal();
     return new Promise((resolve) => {
@@ -395,12 +398,14 @@ export class Panel {
     const s = this.s;
     const phase = s.phase;
     const r = s.ready;
+    const mb = (bytes: number) => (bytes / 1e6).toFixed(1);
+    const receiving = s.receiving && `receiving the mesh… ${mb(s.receiving.bytes)} of ${mb(s.receiving.total)} MB`;
     const [text, cls] = (() => {
       switch (phase.kind) {
-        case 'connecting': return [s.connection.open ? 'Connected: receiving the mesh…' : 'Connecting to the server…', 'busy'];
+        case 'connecting': return [s.connection.open ? `Connected: ${receiving ?? 'receiving the mesh…'}` : 'Connecting to the server…', 'busy'];
         case 'disconnected': return ['Disconnected — edits are paused', 'down'];
         case 'empty': return ['No mesh is open: open one (Open mesh…, or drop a file) or the Demo', 'busy'];
-        case 'loading': return [`${this.aged(phase.stage, progressText(phase))}${s.preparing ? ' · paint handles and fixed parts meanwhile' : ''}`, 'busy'];
+        case 'loading': return [`${receiving ? `${receiving} · ` : ''}${this.aged(phase.stage, progressText(phase))}${s.preparing ? ' · paint handles and fixed parts meanwhile' : ''}`, 'busy'];
         case 'busy': return [`${phase.what}: waiting for the server…`, 'busy'];
         case 'ready': return s.server?.detail_pending
           ? [`${r ? `${r.name}: ` : ''}working: factoring the transfer's details (displacements until then)`, 'busy']
@@ -441,11 +446,11 @@ export class Panel {
     // server's (free pieces, held vertices, modes per piece) once it is ready.
     const served = !!r && editable;
     $('counts').textContent = served || s.paintable
-      ? `handles: ${c.handles.toLocaleString()} vertices in ${c.groups} group${c.groups === 1 ? '' : 's'} · ` +
-        `fixed: ${c.fixed.toLocaleString()} · pinned: ${c.pinned.toLocaleString()}` +
+      ? `handles: ${numbers.format(c.handles)} vertices in ${c.groups} group${c.groups === 1 ? '' : 's'} · ` +
+        `fixed: ${numbers.format(c.fixed)} · pinned: ${numbers.format(c.pinned)}` +
         (served && s.server?.free_pieces ? ` · ${s.server.free_pieces} piece(s) without handles ${s.ready?.settings.unconstrained === 'keep' ? 'held in place' : 'follow the surface'}` : '') +
-        (served && s.influenceHeld ? ` · ${s.influenceHeld.toLocaleString()} held beyond the region of influence (grey)` : '') +
-        (s.viewer.hiddenCount ? ` · hidden: ${s.viewer.hiddenCount.toLocaleString()} (Alt+H shows them)` : '') +
+        (served && s.influenceHeld ? ` · ${numbers.format(s.influenceHeld)} held beyond the region of influence (grey)` : '') +
+        (s.viewer.hiddenCount ? ` · hidden: ${numbers.format(s.viewer.hiddenCount)} (Alt+H shows them)` : '') +
         (served && (s.server?.constrained_piece_modes?.length ?? 0) > 1 ? ` · modes per constrained piece: ${s.server!.constrained_piece_modes.join(', ')}` : '')
       : '';
     this.renderNotes();
@@ -463,7 +468,7 @@ export class Panel {
 
     // The panel: what can be done now.
     $('mesh-name').textContent = r
-      ? `${r.name}: ${r.vertices.toLocaleString()} vertices, ${r.faces.toLocaleString()} triangles`
+      ? `${r.name}: ${numbers.format(r.vertices)} vertices, ${numbers.format(r.faces)} triangles`
       : phase.kind === 'empty' ? 'no mesh open' : phase.kind === 'loading' ? 'preparing the mesh…' : 'connecting…';
     const enable = (id: string, on: boolean) => ($<HTMLButtonElement>(id).disabled = !on);
     for (const id of ['undo', 'redo', 'reset', 'apply-pose', 'export-mesh', 'export-scene', 'clear', 'new-group',
@@ -551,7 +556,7 @@ export class Panel {
     if (changed && r) {
       cost = r.basis.source === 'computed'
         ? `about ${Math.max(0.1, (r.basis.seconds * m) / r.modes).toFixed(1)} s to compute (m = ${r.modes} took ${r.basis.seconds.toFixed(1)} s); Cancel stops it`
-        : `a new basis of ${r.vertices.toLocaleString()} vertices (seconds to minutes); Cancel stops it`;
+        : `a new basis of ${numbers.format(r.vertices)} vertices (seconds to minutes); Cancel stops it`;
     }
     $('modes-cost').textContent = cost;
   }
@@ -637,7 +642,7 @@ export class Panel {
         ? `${f.arap.iterations}${f.arap.converged ? '' : ' (not converged)'} · ${r.arap_clusters} clusters` : '–'],
       ['drag → drawn (median)', stats.latencies.length ? `${median(stats.latencies.slice(-30)).toFixed(0)} ms${age}` : '–'],
       ['updates drawn per second', `${lastSecond}${age}`],
-      ['full draw / preview', s.drawMs ? `${s.drawMs.toFixed(0)} ms / ${s.previewWanted ? `${s.viewer.previewSize.toLocaleString()} vertices` : 'off'}` : '–'],
+      ['full draw / preview', s.drawMs ? `${s.drawMs.toFixed(0)} ms / ${s.previewWanted ? `${numbers.format(s.viewer.previewSize)} vertices` : 'off'}` : '–'],
       ['smooth base misses the handles by', f ? `${(100 * f.error.max).toPrecision(2)}% of the diagonal` : '–'],
     ];
     $('timings').replaceChildren(...rows.map(([k, v]) => {

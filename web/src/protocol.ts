@@ -95,6 +95,7 @@ export interface ErrorMessage {
 }
 
 export type ServerText =
+  | MeshNotice
   | ProgressMessage
   | ReadyMessage
   | StateMessage
@@ -104,6 +105,14 @@ export type ServerText =
   // The basis just computed, written to the cache in the background (after "ready"): once when
   // it starts, once when it is done (with its size and time, or the error).
   | { type: 'saving'; file: string; done: boolean; seconds?: number; bytes?: number; error?: string };
+
+// A mesh to fetch (apps/server/editor_server.h): GET /mesh/ID, its parts (101) one after the
+// other, `bytes` in all.
+export interface MeshNotice {
+  type: 'mesh';
+  id: number;
+  bytes: number;
+}
 
 // ---------------------------------------------------------------- JSON, browser -> server
 
@@ -125,9 +134,13 @@ export interface Selection {
   echo?: boolean; // the server sends it back (a restored edit)
 }
 
-export interface MeshMessage {
-  positions: Float32Array; // 3 n
-  indices: Uint32Array; // 3 T
+// One of a mesh's parts: positions (of vertices [first, first + count)), then triangles.
+export interface MeshPart {
+  n: number;
+  triangles: number;
+  kind: 'positions' | 'triangles';
+  first: number;
+  data: Float32Array | Uint32Array; // 3 count
 }
 
 export interface PreviewMessage {
@@ -260,12 +273,17 @@ export function decodeFile(buffer: ArrayBuffer): NamedFile {
   return { name, data: new Uint8Array(buffer, 8 + Math.ceil(length / 4) * 4) };
 }
 
-export function decodeMesh(buffer: ArrayBuffer): MeshMessage {
-  const [, n, triangles] = new Uint32Array(buffer, 0, 3);
-  return {
-    positions: new Float32Array(buffer, 12, 3 * n),
-    indices: new Uint32Array(buffer, 12 + 12 * n, 3 * triangles),
-  };
+// The part at byte `at` (a multiple of 4) of `buffer`, and its length in bytes, once all of it is
+// within `end`; null before.
+export function decodeMeshPart(buffer: ArrayBuffer, at: number, end: number): [MeshPart, number] | null {
+  if (end - at < 24) return null;
+  const [, n, triangles, kind, first, count] = new Uint32Array(buffer, at, 6);
+  const length = 24 + 12 * count;
+  if (end - at < length) return null;
+  const part: MeshPart = kind === 0
+    ? { n, triangles, kind: 'positions', first, data: new Float32Array(buffer, at + 24, 3 * count) }
+    : { n, triangles, kind: 'triangles', first, data: new Uint32Array(buffer, at + 24, 3 * count) };
+  return [part, length];
 }
 
 export function decodePreview(buffer: ArrayBuffer): PreviewMessage {

@@ -7,7 +7,8 @@ import { Connection, ConnectionStatus } from './connection';
 import type { Slot, WorkerReply, WorkerRequest } from './geometry.worker';
 import type { Measures } from './measures';
 import * as P from './protocol';
-import { Viewer } from './viewer';
+import { filled, Viewer } from './viewer';
+import { forwardPart, MeshArrival, type WholeMesh } from './arrival';
 import { dropHeld, loadHeld, meshKey, saveHeld } from './held';
 
 // Per-vertex labels: 0 free, 1 fixed, 2 + g handle group g.
@@ -39,7 +40,10 @@ export const stats = {
   latencies: [] as number[], // mouse event to its frame drawn (ms)
   receiveLatencies: [] as number[], // to its result received
   drawTimes: [] as number[],
-  meshDrawn: null as number | null, // performance.now() when the last new mesh was first drawn
+  meshStarted: null as number | null, // performance.now() when the last mesh's first part came
+  meshReceived: null as number | null, // its last part
+  meshShown: null as number | null, // when the last new mesh was first drawn whole
+  meshDrawn: null as number | null, // and shaded with its normals
   detailedDrawn: null as number | null, // and when the last frame of the whole mesh was drawn
   pointerMoves: 0, // pointer moves over the view, and how many of them were acted on (coalesced)
   pointerActed: 0,
@@ -56,6 +60,10 @@ const kAlwaysWhole = 50_000;
 // vertices: a few milliseconds on a GPU).
 const kUploadMs = 100;
 const kProgressMs = 500; // a stage's progress shown this often at most
+const kTaskMs = 30; // a mesh's parts are taken in tasks of about this long (ms)
+
+// Resolves in a task of its own: the page draws and takes input in between.
+const nextTask = () => new Promise<void>((resolve) => setTimeout(resolve));
 
 export class EditorState {
   phase: Phase = { kind: 'connecting' };
@@ -80,6 +88,7 @@ export class EditorState {
   private selectionHeld = false; // painted while preparing: sent when the mesh is ready
   private heldKey = ''; // the mesh's name in local storage (held.ts)
   private firstDraw: 'none' | 'shown' | 'drawn' = 'drawn'; // of a new mesh
+  private wholeShown = true; // the new mesh drawn whole (stats.meshShown)
   previewWanted = false;
   private preview: P.PreviewMessage | null = null; // the coarse mesh of drags
   painting = false; // a brush stroke is on (interaction.ts)
@@ -90,6 +99,8 @@ export class EditorState {
   private pendingDraw: number | null = null;
   private outstanding: number | null = null; // the last frame sent, until a result as new arrives
   private lastDrawn = 0;
+  private readonly arrival = new MeshArrival(); // the mesh's parts as they come
+  private arrivalShown = false; // drawn as it comes (a new mesh; the same one again when whole)
   private worker = new Worker(new URL('./geometry.worker.ts', import.meta.url), { type: 'module' });
   private normalsBusy: Record<Slot, boolean> = { full: false, preview: false };
   private normalsQueued: Record<Slot, P.FrameResult | null> = { full: null, preview: null };
@@ -109,8 +120,8 @@ export class EditorState {
     viewer.freeColor = FREE_COLOR;
     connection.on = {
       status: (s) => this.onStatus(s),
-      text: (m) => this.onText(m),
-      binary: (b) => this.onBinary(b),
+      text: (m) => this.receive(() => this.onText(m), m.type === 'progress' || m.type === 'mesh'),
+      binary: (b) => this.receive(() => this.onBinary(b), false),
     };
     this.worker.onmessage = (e: MessageEvent<WorkerReply>) => this.onWorker(e.data);
     viewer.onRendered = () => this.onRendered();
@@ -127,6 +138,15 @@ export class EditorState {
   changed(): void {
     this.progressShown = performance.now();
     for (const l of this.listeners) l();
+  }
+
+  // A change shown now, or kProgressMs after the last one shown (a progress, a mesh's part).
+  private changedSoon(): void {
+    if (performance.now() - this.progressShown >= kProgressMs) return this.changed();
+    this.progressLater ??= window.setTimeout(() => {
+      this.progressLater = undefined;
+      this.changed();
+    }, kProgressMs);
   }
 
   get editable(): boolean {
@@ -285,6 +305,15 @@ export class EditorState {
 
   // ------------------------------------------------------------ incoming
 
+  // The socket's messages after a mesh's notice wait for the mesh (fetched over HTTP, it comes
+  // after them), but for progress and another mesh; they are handled in order once it is taken.
+  private waiting: (() => void)[] | null = null;
+
+  private receive(handle: () => void, now: boolean): void {
+    if (this.waiting && !now) this.waiting.push(handle);
+    else handle();
+  }
+
   private onStatus(s: ConnectionStatus): void {
     if (s.kind === 'open') {
       if (this.phase.kind === 'disconnected') this.note('reconnected to the server');
@@ -317,13 +346,7 @@ export class EditorState {
         this.phase = { kind: 'loading', stage: m.stage, fraction: m.fraction, cancellable: m.cancellable };
         // A stage's progress is shown every kProgressMs at most: each change of the page costs
         // a software renderer a composite of the whole window (30% of a core at 10 a second).
-        if (stage === m.stage && performance.now() - this.progressShown < kProgressMs) {
-          this.progressLater ??= window.setTimeout(() => {
-            this.progressLater = undefined;
-            this.changed();
-          }, kProgressMs);
-          return;
-        }
+        if (stage === m.stage) return this.changedSoon();
         break;
       }
       case 'ready':
@@ -337,6 +360,8 @@ export class EditorState {
       case 'note':
         this.note(m.message);
         break;
+      case 'mesh':
+        return void this.fetchMesh(m);
       case 'saving':
         this.saving = m.done ? null : m.file;
         if (m.done) {
@@ -364,8 +389,6 @@ export class EditorState {
 
   private onBinary(buffer: ArrayBuffer): void {
     switch (P.tagOf(buffer)) {
-      case P.Tag.Mesh:
-        return this.adoptMesh(P.decodeMesh(buffer));
       case P.Tag.Preview: {
         const p = P.decodePreview(buffer);
         this.viewer.setPreview(p.vertices, p.indices);
@@ -420,15 +443,15 @@ export class EditorState {
 
   // The worker makes the positions and their normals (a copy of the displacements goes: the
   // message's buffer holds other fields too).
-  private computeFrame(slot: Slot, seq: number, scale: number, displacements: Int16Array): void {
+  private computeFrame(slot: Slot, seq: number, scale: number, displacements: Int16Array, copy = true): void {
     this.normalsBusy[slot] = true;
     if (slot === 'full') this.measuresAwaited = seq;
-    this.post({ kind: 'frame', slot, seq, scale, displacements: displacements.slice() });
+    this.post({ kind: 'frame', slot, seq, scale, displacements: copy ? displacements.slice() : displacements });
   }
 
   // The rest shape, as a frame without displacements.
   private showRest(): void {
-    this.computeFrame('full', this.seq, 1, new Int16Array(this.rest.length));
+    this.computeFrame('full', this.seq, 1, new Int16Array(this.rest.length), false);
   }
 
   private onWorker(m: WorkerReply): void {
@@ -464,7 +487,7 @@ export class EditorState {
   private postPreview(p: P.PreviewMessage): void {
     const rest = new Float32Array(3 * p.vertices.length);
     p.vertices.forEach((v, i) => rest.set(this.rest.subarray(3 * v, 3 * v + 3), 3 * i));
-    this.post({ kind: 'mesh', slot: 'preview', indices: p.indices.slice(), rest });
+    this.post({ kind: 'preview', indices: p.indices.slice(), rest });
   }
 
   private post(request: WorkerRequest): void {
@@ -473,7 +496,11 @@ export class EditorState {
   }
 
   private onRendered(): void {
-    if (this.firstDraw === 'shown') {
+    if (!this.wholeShown && this.viewer.whole) {
+      this.wholeShown = true;
+      stats.meshShown = performance.now();
+    }
+    if (this.firstDraw === 'shown' && this.viewer.whole) {
       this.firstDraw = 'drawn';
       stats.meshDrawn = performance.now();
       this.previewFrom = this.viewer.draws;
@@ -499,38 +526,115 @@ export class EditorState {
   onConnectionLost: () => string | null = () => null;
   private lostOnDisconnect: string | null = null;
 
-  private adoptMesh(m: P.MeshMessage): void {
+  // The bytes of the mesh come so far, and of all of it, while it comes.
+  get receiving(): { bytes: number; total: number } | null {
+    const a = this.arrival;
+    return a.mesh && !a.whole ? { bytes: a.bytes, total: a.totalBytes } : null;
+  }
+
+  // Fetches the mesh the server names and takes its parts as they come, a task at a time (a
+  // newer one's fetch drops it); the socket's other messages wait meanwhile.
+  private async fetchMesh(m: P.MeshNotice): Promise<void> {
+    const fetching = ++this.meshFetches;
+    this.waiting ??= [];
+    try {
+      const response = await fetch(`/mesh/${m.id}`);
+      if (!response.ok || !response.body) throw new Error(`${response.status} ${response.statusText}`);
+      const reader = response.body.getReader();
+      const bytes = new Uint8Array(m.bytes);
+      let [end, at, task] = [0, 0, performance.now()];
+      for (;;) {
+        const { done, value } = await reader.read();
+        if (fetching !== this.meshFetches) return void reader.cancel();
+        if (done) break;
+        if (end + value.length > bytes.length) throw new Error('more bytes than announced');
+        bytes.set(value, end);
+        end += value.length;
+        for (let next; (next = P.decodeMeshPart(bytes.buffer, at, end)); at += next[1]) {
+          if (performance.now() - task > kTaskMs) {
+            await nextTask();
+            if (fetching !== this.meshFetches) return void reader.cancel();
+            task = performance.now();
+          }
+          await this.meshPart(next[0]);
+        }
+      }
+      if (at !== bytes.length) throw new Error(`${at} of ${bytes.length} bytes`);
+    } catch (e) {
+      if (fetching !== this.meshFetches) return;
+      this.arrival.mesh = null;
+      this.note(`the mesh did not arrive: ${e instanceof Error ? e.message : e}`, 'error');
+    }
+    const waiting = this.waiting ?? [];
+    this.waiting = null;
+    for (const handle of waiting) handle();
+    this.changed();
+  }
+  private meshFetches = 0;
+
+  // Takes a part; the last one's mesh is taken in a few tasks (the promise).
+  private async meshPart(p: P.MeshPart): Promise<void> {
+    if (p.kind === 'positions' && p.first === 0) {
+      stats.meshStarted = performance.now();
+      this.arrivalShown = 3 * p.n !== this.rest.length || 3 * p.triangles !== this.indices.length;
+    }
+    const done = this.arrival.add(p);
+    forwardPart(this.worker, p);
+    this.viewer.meshPart(p);
+    if (done) await nextTask(); // what follows takes a task of its own
+    const { positions, indices } = this.arrival.mesh!;
+    if (this.arrivalShown && p.kind === 'positions' && done) this.viewer.beginMesh(positions, indices);
+    if (this.arrivalShown && p.kind === 'triangles') this.viewer.addTriangles(p.first, p.data.length / 3);
+    if (done === 'mesh') {
+      stats.meshReceived = performance.now();
+      this.changed();
+      return this.adoptMesh(this.arrival.mesh!, this.arrivalShown);
+    }
+    if (done) this.changed();
+    else this.changedSoon();
+  }
+
+  // A whole mesh; `shown`: drawn as it came (beginMesh). Its arrays are the state's from here.
+  // Taken in three tasks (a 692k mesh's passes held the page half a second): the state (with a
+  // selection held for it) and the view, then the worker's mesh and the rest shape, then the
+  // colours.
+  private async adoptMesh(m: WholeMesh, shown: boolean): Promise<void> {
     const sameTriangles = m.indices.length === this.indices.length && m.indices.every((v, i) => v === this.indices[i]);
     const samePositions = sameTriangles && m.positions.every((v, i) => v === this.rest[i]);
     if (samePositions) return; // a reconnection: keep the view and what is shown
-    this.rest = m.positions.slice();
+    this.rest = m.positions;
     const n = this.rest.length / 3;
-    this.viewer.setMesh(this.rest, m.indices, sameTriangles);
-    this.post({ kind: 'mesh', slot: 'full', indices: m.indices.slice(), rest: this.rest.slice() });
-    this.showRest();
-    if (sameTriangles && this.preview) this.postPreview(this.preview); // another pose
+    this.viewer.setMesh(this.rest.slice(), m.indices, sameTriangles, shown);
     if (!sameTriangles) {
       // Another mesh: the selection goes (the server says so too), the preview is measured again
       // once it is drawn. It is painted while its basis is computed. What belonged to the old one
       // on screen (the gizmo, the 3D cursor, a drag, an armed mode) goes with it.
       this.onAnotherMesh();
-      this.indices = m.indices.slice();
+      this.indices = m.indices;
       this.labels = new Int16Array(n);
+      this.colorBuffer = filled(n, FREE_COLOR); // as the view has it
       this.groups = [{ transform: new THREE.Matrix4(), pinned: false }];
       this.activeGroup = 0;
       this.previewWanted = false;
       this.preview = null;
       this.drawMs = 0;
-      this.diagonal = diagonalOf(this.rest);
       this.preparing = true;
       this.selectionHeld = false;
       this.firstDraw = 'none';
+      this.wholeShown = false;
       this.previewFrom = null;
-      this.heldKey = meshKey(this.rest, this.indices);
       this.heldTime = 0; // another mesh: any held selection of it is newer than none
+      this.heldKey = meshKey(this.rest, this.indices);
       this.selectionHeld = this.adoptHeld();
-      this.paint();
     }
+    await nextTask();
+    this.post({ kind: 'adopt' }); // the parts it was sent
+    this.showRest();
+    if (sameTriangles && this.preview) this.postPreview(this.preview); // another pose
+    if (sameTriangles) return;
+    await nextTask();
+    this.diagonal = diagonalOf(this.rest);
+    this.paint();
   }
 
   // The selection held for this mesh in local storage (a reload, another window), if newer than
@@ -723,16 +827,16 @@ export class EditorState {
     const heldAt = 3 * (top + 1);
     table.set([HELD_COLOR.r, HELD_COLOR.g, HELD_COLOR.b], heldAt);
     let changed = false;
-    const set = (v: number) => {
+    const count = vertices ? vertices.length : n;
+    for (let i = 0; i < count; ++i) {
+      const v = vertices ? vertices[i] : i;
       const k = labels[v] === FREE && held?.[v] ? heldAt : 3 * labels[v];
-      if (colors[3 * v] === table[k] && colors[3 * v + 1] === table[k + 1] && colors[3 * v + 2] === table[k + 2]) return;
+      if (colors[3 * v] === table[k] && colors[3 * v + 1] === table[k + 1] && colors[3 * v + 2] === table[k + 2]) continue;
       colors[3 * v] = table[k];
       colors[3 * v + 1] = table[k + 1];
       colors[3 * v + 2] = table[k + 2];
       changed = true;
-    };
-    if (vertices) for (let i = 0; i < vertices.length; ++i) set(vertices[i]);
-    else for (let v = 0; v < n; ++v) set(v);
+    }
     // The same colours again (the selection as the server confirms it) redraw nothing: a draw
     // of a million triangles costs a second of CPU without a GPU.
     if (changed) this.viewer.setColors(colors, vertices);

@@ -8,9 +8,11 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TransformControls } from 'three/addons/controls/TransformControls.js';
 import { MeshBVH } from 'three-mesh-bvh';
 import type { BvhReply, BvhRequest } from './bvh.worker';
+import { forwardPart } from './arrival';
+import { GpuArray } from './gpu';
 import { visibleTriangles } from './hide';
 import { FileLook } from './look';
-import type { AppearanceMessage } from './protocol';
+import type { AppearanceMessage, MeshPart } from './protocol';
 
 export interface Hit {
   point: THREE.Vector3;
@@ -39,9 +41,18 @@ export class Viewer {
 
   readonly scene = new THREE.Scene();
   private readonly geometry = new THREE.BufferGeometry(); // every triangle: picking, positions
-  private readonly drawn = new THREE.BufferGeometry(); // the same attributes, the shown triangles
+  // What is drawn: the same vertex arrays and the shown triangles, in buffers filled a part at a
+  // time (gpu.ts), at most kUploadBytes a frame while a mesh arrives; the wireframe's own.
+  private readonly drawn = new THREE.BufferGeometry();
+  private readonly gpu: Record<'position' | 'normal' | 'color' | 'index', GpuArray>;
+  private readonly wireGeometry = new THREE.BufferGeometry();
+  private arriving = false; // the mesh's parts are coming: uploads keep to kUploadBytes a frame
   private hiddenMask: Uint8Array | null = null; // per vertex: hidden (H), with its triangles
   private readonly surface: THREE.Mesh;
+  // Smooth with the vertex normals; flat (each triangle's own, no normals needed) while a mesh
+  // arrives and until its normals come.
+  private readonly smooth = new THREE.MeshLambertMaterial({ vertexColors: true });
+  private readonly flat = new THREE.MeshLambertMaterial({ vertexColors: true, flatShading: true });
   private readonly wireframe: THREE.Mesh;
   private readonly coarseGeometry = new THREE.BufferGeometry();
   private readonly coarse: THREE.Mesh;
@@ -74,12 +85,19 @@ export class Viewer {
     this.camera.add(light);
     this.scene.add(this.camera);
 
-    const material = new THREE.MeshLambertMaterial({ vertexColors: true });
-    this.surface = new THREE.Mesh(this.drawn, material);
-    this.coarse = new THREE.Mesh(this.coarseGeometry, material);
+    const gl = this.renderer.getContext() as WebGL2RenderingContext;
+    this.renderer.resetState();
+    this.gpu = {
+      position: new GpuArray(gl, gl.ARRAY_BUFFER, 3, new Float32Array(0)),
+      normal: new GpuArray(gl, gl.ARRAY_BUFFER, 3, new Float32Array(0)),
+      color: new GpuArray(gl, gl.ARRAY_BUFFER, 3, new Float32Array(0)),
+      index: new GpuArray(gl, gl.ELEMENT_ARRAY_BUFFER, 1, new Uint32Array(0)),
+    };
+    this.surface = new THREE.Mesh(this.drawn, this.flat);
+    this.coarse = new THREE.Mesh(this.coarseGeometry, this.smooth);
     this.coarse.visible = false;
     this.wireframe = new THREE.Mesh(
-      this.drawn,
+      this.wireGeometry,
       new THREE.MeshBasicMaterial({ color: 0x20242c, wireframe: true, transparent: true, opacity: 0.25 }),
     );
     this.wireframe.visible = false;
@@ -100,6 +118,8 @@ export class Viewer {
     this.cursorMark.visible = false;
     this.cursorMark.renderOrder = 2;
     this.scene.add(this.surface, this.look.mesh, this.coarse, this.wireframe, this.pivot, this.cursorMark);
+    // The surface's two programs compiled before the mesh comes (a first use waits for them).
+    this.renderer.compile(this.scene, this.camera);
     this.previewLabel = Object.assign(document.createElement('div'), {
       id: 'preview-label', textContent: 'preview; detail on release', hidden: true });
     this.axes = Object.assign(document.createElement('canvas'), { id: 'axes', width: 96, height: 96,
@@ -139,38 +159,125 @@ export class Viewer {
     return this.renderer.domElement;
   }
 
-  // A new mesh; `keepCamera` for another pose of the same one.
-  setMesh(positions: Float32Array, indices: Uint32Array, keepCamera: boolean): void {
+  // A new mesh as it arrives: its positions (framed at once), in the free colour, then its
+  // triangles a part at a time (addTriangles), drawn flat until setMesh and its normals.
+  // `positions` and `indices` are the arrays the parts fill; read until setMesh.
+  beginMesh(positions: Float32Array, indices: Uint32Array): void {
     const n = positions.length / 3;
-    this.geometry.setIndex(new THREE.BufferAttribute(indices.slice(), 1));
-    this.geometry.setAttribute('position', new THREE.BufferAttribute(positions.slice(), 3));
+    this.arriving = true;
+    this.renderer.resetState();
+    this.gpu.position.set(positions);
+    this.gpu.normal.fresh(new Float32Array(3 * n)); // not drawn until setPositions
+    this.gpu.color.set(filled(n, this.freeColor));
+    this.gpu.index.fresh(indices);
+    this.drawn.setDrawRange(0, 0);
+    this.bindDrawn();
+    [this.hiddenMask, this.hiddenCount] = [null, 0];
+    this.geometry.setIndex(null);
+    this.bvh = null;
+    this.look.set(null);
+    this.shading = 'flat';
+    this.showSurface();
+    const sphere = new THREE.Sphere();
+    new THREE.Box3().setFromArray(positions).getBoundingSphere(sphere);
+    this.frameMesh(sphere);
+    this.uploadLater();
+  }
+
+  // Every part of every mesh, for the picking BVH's worker (setMesh builds it).
+  meshPart(part: MeshPart): void {
+    forwardPart(this.bvhWorker, part);
+  }
+
+  // Triangles [first, first + count) of the arriving mesh came.
+  addTriangles(first: number, count: number): void {
+    this.gpu.index.update(3 * first, 3 * count);
+    this.drawn.setDrawRange(0, 3 * (first + count));
+    this.uploadLater();
+  }
+
+  // A new mesh; `keepCamera` for another pose of the same one; `arrived`: the mesh that
+  // beginMesh and addTriangles showed as it came. The viewer keeps both arrays (`positions`
+  // changes with each frame).
+  setMesh(positions: Float32Array, indices: Uint32Array, keepCamera: boolean, arrived = false): void {
+    const n = positions.length / 3;
+    this.geometry.setIndex(new THREE.BufferAttribute(indices, 1));
+    this.geometry.setAttribute('position', new THREE.BufferAttribute(positions, 3));
     const colors = this.geometry.getAttribute('color');
     if (!colors || colors.count !== n) {
-      this.geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
+      this.geometry.setAttribute('color', new THREE.BufferAttribute(filled(n, this.freeColor), 3));
     }
     this.geometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
     this.geometry.computeBoundingSphere();
-    for (const name of ['position', 'normal', 'color']) this.drawn.setAttribute(name, this.geometry.getAttribute(name));
+    this.renderer.resetState();
+    this.gpu.position.set(positions, arrived);
+    this.gpu.normal.set(this.normals(), true); // not drawn until setPositions uploads them
+    this.gpu.color.set(this.geometry.getAttribute('color').array as Float32Array, arrived);
     if (!keepCamera) [this.hiddenMask, this.hiddenCount] = [null, 0];
-    this.showHidden();
+    this.showHidden(arrived);
+    this.bindDrawn();
     this.bvh = null; // built by the worker (seconds for a million triangles)
     this.bvhStale = false;
-    const request: BvhRequest = { id: ++this.bvhRequest, indices: indices.slice(), positions: positions.slice() };
-    this.bvhWorker.postMessage(request, [request.indices.buffer, request.positions.buffer]);
+    this.bvhWorker.postMessage({ kind: 'build', id: ++this.bvhRequest } satisfies BvhRequest);
     this.coarse.visible = false;
-    this.shaded = false;
-    if (!keepCamera) this.look.set(null); // another mesh: its look, if any, follows
+    this.shading = 'flat';
+    if (!keepCamera && !arrived) this.look.set(null); // another mesh: its look, if any, follows
     this.showSurface();
-    if (!keepCamera) {
-      const sphere = this.geometry.boundingSphere!;
-      this.camera.near = sphere.radius / 100;
-      this.camera.far = sphere.radius * 100;
-      this.camera.updateProjectionMatrix();
-      this.frameSphere(sphere);
-      this.home = { position: this.camera.position.clone(), target: this.orbit.target.clone() };
-      this.gizmo.setSize(0.8);
-    }
-    this.changedContent();
+    if (!keepCamera && !arrived) this.frameMesh(this.geometry.boundingSphere!);
+    this.uploadLater();
+  }
+
+  // The camera framing a new mesh's bounding sphere, and there again on Home.
+  private frameMesh(sphere: THREE.Sphere): void {
+    this.camera.near = sphere.radius / 100;
+    this.camera.far = sphere.radius * 100;
+    this.camera.updateProjectionMatrix();
+    this.frameSphere(sphere);
+    this.home = { position: this.camera.position.clone(), target: this.orbit.target.clone() };
+    this.gizmo.setSize(0.8);
+  }
+
+  // The drawn geometries take the GPU arrays' attributes (new ones with each new size).
+  private bindDrawn(): void {
+    this.drawn.setAttribute('position', this.gpu.position.drawn);
+    this.drawn.setAttribute('normal', this.gpu.normal.drawn);
+    this.drawn.setAttribute('color', this.gpu.color.drawn);
+    this.drawn.setIndex(this.gpu.index.drawn);
+    this.wireGeometry.setAttribute('position', this.gpu.position.drawn);
+  }
+
+  // Changed GPU arrays go up before the next draw, or, while a mesh arrives, kUploadBytes a
+  // task of its own (not a frame: a draw of the mesh coming would hold it); the view is drawn as they go.
+  private uploadLater(): void {
+    if (!this.arriving) return this.changedContent();
+    if (this.uploadQueued) return;
+    this.uploadQueued = true;
+    setTimeout(() => {
+      this.uploadQueued = false;
+      this.upload(kUploadBytes);
+      const left = Object.values(this.gpu).some((a) => a.pendingBytes > 0);
+      if (!left && this.geometry.index) { // setMesh came: arrived whole
+        this.arriving = false;
+        this.showSurface();
+      }
+      // Drawn now and then as it comes: each draw of it costs a software renderer as much as
+      // the whole mesh's.
+      if (!this.arriving || performance.now() - this.lastDraw > kArrivalDrawMs) this.changedContent();
+      if (left) this.uploadLater();
+    });
+  }
+  private uploadQueued = false;
+
+  private upload(budget: number): void {
+    const arrays = Object.values(this.gpu).filter((a) => a.pendingBytes > 0);
+    if (arrays.length === 0) return;
+    this.renderer.resetState(); // three.js's GL state: bound vertex arrays and buffers
+    for (const a of arrays) budget -= a.flush(budget);
+  }
+
+  // Whether the mesh is drawn whole: all of it arrived and uploaded.
+  get whole(): boolean {
+    return !this.arriving && this.geometry.index !== null;
   }
 
   positions(): Float32Array {
@@ -207,13 +314,16 @@ export class Viewer {
     return this.look.mesh.visible;
   }
 
-  // The mesh is drawn once its normals have come (setPositions), not before, unshaded.
+  // The mesh is drawn flat until its normals have come (setPositions), then smooth; its file's
+  // look needs them.
   private showSurface(): void {
     const look = this.look.present && this.lookShown;
-    this.look.mesh.visible = this.shaded && look;
-    this.surface.visible = this.shaded && !look;
+    const smooth = this.shading === 'smooth' && !this.arriving; // its normals uploaded
+    this.look.mesh.visible = smooth && look;
+    this.surface.visible = this.shading !== 'none' && !this.look.mesh.visible;
+    this.surface.material = smooth ? this.smooth : this.flat;
   }
-  private shaded = false;
+  private shading: 'none' | 'flat' | 'smooth' = 'none';
 
   // A full frame: positions and their normals (computed off the main thread), and the file
   // look's normals when it has one.
@@ -221,20 +331,21 @@ export class Viewer {
     const p = this.geometry.getAttribute('position') as THREE.BufferAttribute;
     const nrm = this.geometry.getAttribute('normal') as THREE.BufferAttribute;
     // The same again (a frame at the rest shape while it is shown): nothing to upload or draw.
-    const same = this.shaded && !this.coarse.visible && equal(p.array as Float32Array, positions) &&
+    const same = this.shading === 'smooth' && !this.coarse.visible && equal(p.array as Float32Array, positions) &&
       equal(nrm.array as Float32Array, normals) && (lookNormals === null || this.look.hasNormals(lookNormals));
     this.previewLabel.hidden = true;
     if (same) return this.requestRender(); // answered by onRendered, without a draw
+    // The rest shape's first frame brings only its normals.
+    if (!equal(p.array as Float32Array, positions)) this.gpu.position.update(0, p.count);
     (p.array as Float32Array).set(positions);
-    p.needsUpdate = true;
     (nrm.array as Float32Array).set(normals);
-    nrm.needsUpdate = true;
+    this.gpu.normal.update(0, nrm.count);
     this.bvhStale = true;
     this.coarse.visible = false;
-    this.shaded = true;
+    this.shading = 'smooth';
     this.look.setPositions(positions, lookNormals);
     this.showSurface();
-    this.changedContent();
+    this.uploadLater();
   }
 
   // Colours (3 floats per vertex) of the vertices listed, or of all.
@@ -242,8 +353,12 @@ export class Viewer {
     const attribute = this.geometry.getAttribute('color') as THREE.BufferAttribute;
     const array = attribute.array as Float32Array;
     if (!vertices) {
+      // Only the changed span goes up (the first paint of a mesh drawn in the free colour: none).
+      let lo = 0, hi = array.length;
+      while (lo < hi && array[lo] === colors[lo]) ++lo;
+      while (hi > lo && array[hi - 1] === colors[hi - 1]) --hi;
       array.set(colors);
-      attribute.clearUpdateRanges();
+      this.gpu.color.update(Math.floor(lo / 3), Math.ceil(hi / 3) - Math.floor(lo / 3));
     } else {
       let lo = Infinity, hi = -1;
       for (let i = 0; i < vertices.length; ++i) {
@@ -255,13 +370,11 @@ export class Viewer {
         hi = Math.max(hi, v);
       }
       if (hi < 0) return;
-      attribute.clearUpdateRanges();
-      attribute.addUpdateRange(3 * lo, 3 * (hi - lo + 1)); // only the changed span is uploaded
+      this.gpu.color.update(lo, hi - lo + 1); // only the changed span is uploaded
     }
-    attribute.needsUpdate = true;
     this.syncCoarseColors();
     this.look.setColors(array, this.freeColor);
-    this.changedContent();
+    this.uploadLater();
   }
 
   // The coarse mesh of drags: some mesh vertices and triangles between them.
@@ -332,29 +445,37 @@ export class Viewer {
     }
     this.hiddenCount = this.hiddenMask?.reduce((a, h) => a + h, 0) ?? 0;
     if (this.hiddenCount === 0) this.hiddenMask = null;
+    this.renderer.resetState();
     this.showHidden();
-    this.changedContent();
+    this.uploadLater();
     return this.hiddenCount;
   }
   hiddenCount = 0;
 
   get drawnTriangles(): number {
-    return (this.drawn.index?.count ?? 0) / 3;
+    return this.gpu.index.array.length / 3;
   }
 
   get hidden(): Uint8Array | null {
     return this.hiddenMask;
   }
 
-  private showHidden(): void {
+  // The shown triangles to the GPU (`uploaded`: all of them, there already or on their way).
+  // The caller resets three.js's GL state first.
+  private showHidden(uploaded = false): void {
     const index = this.geometry.index;
     if (!index) return;
     const hidden = this.hiddenMask;
-    this.drawn.setIndex(hidden ? new THREE.BufferAttribute(visibleTriangles(index.array as Uint32Array, hidden), 1) : index);
+    const shown = hidden ? visibleTriangles(index.array as Uint32Array, hidden) : index.array as Uint32Array;
+    this.gpu.index.set(shown, uploaded && !hidden);
+    this.drawn.setDrawRange(0, Infinity);
+    this.drawn.setIndex(this.gpu.index.drawn);
+    this.wireGeometry.setIndex(new THREE.BufferAttribute(shown, 1));
     // Behind a hidden part the inside of the surface shows, as in Blender.
-    const material = this.surface.material as THREE.MeshLambertMaterial;
     const side = hidden ? THREE.DoubleSide : THREE.FrontSide;
-    if (material.side !== side) [material.side, material.needsUpdate] = [side, true];
+    for (const material of [this.smooth, this.flat]) {
+      if (material.side !== side) [material.side, material.needsUpdate] = [side, true];
+    }
     if (this.coarseIndices.length > 0) {
       this.coarseGeometry.setIndex(new THREE.BufferAttribute(visibleTriangles(this.coarseIndices, hidden, this.coarseVertices), 1));
     }
@@ -546,6 +667,7 @@ export class Viewer {
         return this.onRendered(); // what was asked for is on the screen already
       }
       [this.shown, this.drawAgain] = [showing, false];
+      if (!this.arriving) this.upload(Infinity);
       this.renderer.render(this.scene, this.view);
       this.lastDraw = performance.now();
       ++this.draws;
@@ -668,6 +790,15 @@ export class Viewer {
   }
 }
 
+// n colours, all `color`: a new mesh's, before it is painted.
+export function filled(n: number, color: THREE.Color): Float32Array<ArrayBuffer> {
+  const colors = new Float32Array(3 * n);
+  if (n === 0) return colors;
+  colors.set([color.r, color.g, color.b]);
+  for (let done = 3; done < colors.length; done *= 2) colors.copyWithin(done, 0, Math.min(done, colors.length - done));
+  return colors;
+}
+
 function equal(a: Float32Array, b: Float32Array): boolean {
   if (a.length !== b.length) return false;
   for (let i = 0; i < a.length; ++i) if (a[i] !== b[i]) return false;
@@ -676,6 +807,10 @@ function equal(a: Float32Array, b: Float32Array): boolean {
 
 // Draws slower than this are spaced out (requestRender).
 const kSlowDrawMs = 50;
+// Uploaded a frame while a mesh arrives: 4 MB, tens of milliseconds of the page's thread on a
+// software renderer with the server's basis computing beside it.
+const kUploadBytes = 4 << 20;
+const kArrivalDrawMs = 1e9; // a mesh coming is drawn this often at most
 
 // The renderer, without multisampling where the context is a software renderer (no GPU: it
 // would spend most of a frame on it), with it otherwise. One context is made there (a second

@@ -1,0 +1,83 @@
+// An array of the drawn surface (positions, normals, colours or triangles) in a WebGL buffer made
+// here and filled a range at a time. three.js's own attributes upload a whole array in one call:
+// 25 MB at 692k vertices, most of a second of the page's thread on a software renderer while the
+// server computes a basis beside it. Changed ranges wait for `flush`, which uploads at most a
+// budget of bytes of them, so that a large mesh is uploaded over several frames.
+import * as THREE from 'three';
+
+export type GpuTypedArray = Float32Array | Uint32Array;
+
+export class GpuArray {
+  attribute: THREE.GLBufferAttribute;
+  private buffer: WebGLBuffer | null = null;
+  private pending: [number, number][] = []; // [begin, end) elements of `array` not uploaded yet
+
+  // `target`: ARRAY_BUFFER for vertex attributes, ELEMENT_ARRAY_BUFFER for triangles.
+  constructor(
+    private readonly gl: WebGL2RenderingContext,
+    private readonly target: GLenum,
+    private readonly itemSize: number,
+    public array: GpuTypedArray,
+  ) {
+    this.attribute = this.allocate(array);
+  }
+
+  // Another array, all of it to upload; `same`: it holds the values of the one it replaces (what
+  // was pending still is). A new length makes a new buffer and attribute: the geometry takes
+  // `drawn` again.
+  set(array: GpuTypedArray, same = false): void {
+    if (array.length !== this.array.length) this.attribute = this.allocate(array);
+    this.array = array;
+    if (!same) this.pending = [[0, array.length]];
+  }
+
+  // A new buffer for `array`, whose values are uploaded as they come (update): a new buffer
+  // holds zeros.
+  fresh(array: GpuTypedArray): void {
+    this.attribute = this.allocate(array);
+    this.array = array;
+    this.pending = [];
+  }
+
+  // Items [first, first + count) changed.
+  update(first: number, count: number): void {
+    if (count > 0) this.pending.push([first * this.itemSize, (first + count) * this.itemSize]);
+  }
+
+  // The attribute as a geometry takes it: three.js draws a GLBufferAttribute where a
+  // BufferAttribute goes, which its type declarations do not say.
+  get drawn(): THREE.BufferAttribute {
+    return this.attribute as unknown as THREE.BufferAttribute;
+  }
+
+  get pendingBytes(): number {
+    return this.pending.reduce((sum, [b, e]) => sum + 4 * (e - b), 0);
+  }
+
+  // Uploads pending ranges in order, at most `budget` bytes (the rest waits for the next call);
+  // returns the bytes uploaded. The caller resets three.js's GL state around it.
+  flush(budget: number): number {
+    let done = 0;
+    const gl = this.gl;
+    gl.bindBuffer(this.target, this.buffer);
+    while (this.pending.length > 0 && done < budget) {
+      const [begin, end] = this.pending[0];
+      const stop = Math.min(end, begin + Math.max(1, Math.floor((budget - done) / 4)));
+      gl.bufferSubData(this.target, 4 * begin, this.array, begin, stop - begin);
+      done += 4 * (stop - begin);
+      if (stop === end) this.pending.shift();
+      else this.pending[0][0] = stop;
+    }
+    return done;
+  }
+
+  private allocate(array: GpuTypedArray): THREE.GLBufferAttribute {
+    const gl = this.gl;
+    if (this.buffer) gl.deleteBuffer(this.buffer);
+    this.buffer = gl.createBuffer();
+    gl.bindBuffer(this.target, this.buffer);
+    gl.bufferData(this.target, array.byteLength, gl.DYNAMIC_DRAW);
+    const type = array instanceof Float32Array ? gl.FLOAT : gl.UNSIGNED_INT;
+    return new THREE.GLBufferAttribute(this.buffer!, type, this.itemSize, 4, array.length / this.itemSize);
+  }
+}
