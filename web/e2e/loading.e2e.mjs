@@ -116,6 +116,11 @@ try {
   // 1. The mesh on screen before its basis.
   await page.waitForFunction(() => window.specdeformEditor?.stats.meshDrawn !== null, null, { timeout: 120000 });
   const drawn = await api(() => ({ at: window.specdeformEditor.stats.meshDrawn, phase: window.specdeformEditor.phase }));
+  // The mesh's arrival: its first and last parts, drawn whole (flat), then shaded.
+  const arrival = await api(() => window.specdeformEditor.stats);
+  result.mesh_first_byte_s = arrival.meshStarted / 1000;
+  result.mesh_received_s = arrival.meshReceived / 1000;
+  result.mesh_shown_s = arrival.meshShown / 1000;
   result.mesh_drawn_s = drawn.at / 1000;
   log(`mesh drawn at ${result.mesh_drawn_s.toFixed(2)} s, phase ${drawn.phase}`);
   const shades = await api(() => {
@@ -253,8 +258,12 @@ try {
   result.drag_detailed_after_release_s = (Date.now() - up) / 1000;
   result.first_drag_drawn_s = (await now()) / 1000;
   // Where the page's main thread was held (tasks over 50 ms), up to the drag's detail.
-  result.long_tasks_s = (await api(() => window.longTasks)).sort((a, b) => b[1] - a[1]).slice(0, 8)
+  const longTasks = await api(() => window.longTasks);
+  result.long_tasks_s = longTasks.sort((a, b) => b[1] - a[1]).slice(0, 8)
     .map(([t, d]) => [+(t / 1000).toFixed(2), +(d / 1000).toFixed(2)]);
+  // From the mesh's first byte to the first drag (its press): the page answers throughout.
+  result.longest_task_to_drag_s = +(Math.max(0, ...longTasks
+    .filter(([t]) => t >= arrival.meshStarted && t < result.drag_started_s * 1000).map(([, d]) => d)) / 1000).toFixed(3);
   result.messages_s = messages.filter(([t]) => t <= result.first_drag_drawn_s + 0.5);
   const moved = await api(() => window.specdeformEditor.transforms()[0]);
   check(Math.hypot(moved[3], moved[7], moved[11]) > 0, 'the drag moved the handle');

@@ -2,7 +2,8 @@
 // here and filled a range at a time. three.js's own attributes upload a whole array in one call:
 // 25 MB at 692k vertices, most of a second of the page's thread on a software renderer while the
 // server computes a basis beside it. Changed ranges wait for `flush`, which uploads at most a
-// budget of bytes of them, so that a large mesh is uploaded over several frames.
+// budget of bytes of them, so that a large mesh is uploaded over several tasks; a whole new
+// frame goes to a second buffer meanwhile (`frame`), drawn once it is all there.
 import * as THREE from 'three';
 
 export type GpuTypedArray = Float32Array | Uint32Array;
@@ -11,6 +12,8 @@ export class GpuArray {
   attribute: THREE.GLBufferAttribute;
   private buffer: WebGLBuffer | null = null;
   private pending: [number, number][] = []; // [begin, end) elements of `array` not uploaded yet
+  private back: WebGLBuffer | null = null; // the next frame's buffer, while it is filled
+  private backDone = -1; // elements of `array` in it so far; -1: no frame pending
 
   // `target`: ARRAY_BUFFER for vertex attributes, ELEMENT_ARRAY_BUFFER for triangles.
   constructor(
@@ -28,6 +31,7 @@ export class GpuArray {
   set(array: GpuTypedArray, same = false): void {
     if (array.length !== this.array.length) this.attribute = this.allocate(array);
     this.array = array;
+    this.backDone = -1; // a frame on its way is dropped
     if (!same) this.pending = [[0, array.length]];
   }
 
@@ -42,6 +46,46 @@ export class GpuArray {
   // Items [first, first + count) changed.
   update(first: number, count: number): void {
     if (count > 0) this.pending.push([first * this.itemSize, (first + count) * this.itemSize]);
+  }
+
+  // A whole new frame (the same length): uploaded into a second buffer by flushFrame while this
+  // one is drawn (a newer frame meanwhile starts it again).
+  frame(array: GpuTypedArray): void {
+    this.array = array;
+    this.pending = [];
+    this.backDone = 0;
+  }
+
+  // Uploads up to `budget` bytes of a pending frame; returns the bytes uploaded.
+  flushFrame(budget: number): number {
+    if (this.backDone < 0 || this.frameReady) return 0;
+    const gl = this.gl;
+    if (!this.back) {
+      this.back = gl.createBuffer();
+      gl.bindBuffer(this.target, this.back);
+      gl.bufferData(this.target, this.array.byteLength, gl.DYNAMIC_DRAW);
+    }
+    const stop = Math.min(this.array.length, this.backDone + Math.max(1, Math.floor(budget / 4)));
+    gl.bindBuffer(this.target, this.back);
+    gl.bufferSubData(this.target, 4 * this.backDone, this.array, this.backDone, stop - this.backDone);
+    const bytes = 4 * (stop - this.backDone);
+    this.backDone = stop;
+    return bytes;
+  }
+
+  // A frame is on its way, or all there (frameReady) to be drawn (swap).
+  get framePending(): boolean {
+    return this.backDone >= 0;
+  }
+
+  get frameReady(): boolean {
+    return this.backDone === this.array.length;
+  }
+
+  // The frame all there is drawn from here: a new `attribute`.
+  swap(): void {
+    [this.buffer, this.back, this.backDone] = [this.back, this.buffer, -1];
+    this.attribute = new THREE.GLBufferAttribute(this.buffer!, this.attribute.type, this.itemSize, 4, this.attribute.count);
   }
 
   // The attribute as a geometry takes it: three.js draws a GLBufferAttribute where a
@@ -74,6 +118,8 @@ export class GpuArray {
   private allocate(array: GpuTypedArray): THREE.GLBufferAttribute {
     const gl = this.gl;
     if (this.buffer) gl.deleteBuffer(this.buffer);
+    if (this.back) gl.deleteBuffer(this.back);
+    [this.back, this.backDone] = [null, -1];
     this.buffer = gl.createBuffer();
     gl.bindBuffer(this.target, this.buffer);
     gl.bufferData(this.target, array.byteLength, gl.DYNAMIC_DRAW);

@@ -7,7 +7,7 @@ import { Connection, ConnectionStatus } from './connection';
 import type { Slot, WorkerReply, WorkerRequest } from './geometry.worker';
 import type { Measures } from './measures';
 import * as P from './protocol';
-import { filled, Viewer } from './viewer';
+import { Viewer } from './viewer';
 import { forwardPart, MeshArrival, type WholeMesh } from './arrival';
 import { dropHeld, loadHeld, meshKey, saveHeld } from './held';
 
@@ -467,12 +467,14 @@ export class EditorState {
     }
     this.normalsBusy[m.slot] = false;
     const newer = m.slot === 'full' || !this.fullAfter(m.seq);
-    if (m.slot === 'full' && this.firstDraw === 'none') this.firstDraw = 'shown';
-    if (m.slot === 'full') {
+    // A frame of the mesh before (computed while another one was taken) is dropped.
+    const current = m.slot !== 'full' || m.positions.length === this.rest.length;
+    if (current && m.slot === 'full' && this.firstDraw === 'none') this.firstDraw = 'shown';
+    if (current && m.slot === 'full') {
       this.viewer.setPositions(m.positions, m.normals, m.lookNormals);
     }
-    else if (newer) this.viewer.showPreview(m.positions, m.normals);
-    this.pendingDraw = Math.max(this.pendingDraw ?? 0, m.seq);
+    else if (current && newer) this.viewer.showPreview(m.positions, m.normals);
+    if (current) this.pendingDraw = Math.max(this.pendingDraw ?? 0, m.seq);
     const queued = this.normalsQueued[m.slot];
     this.normalsQueued[m.slot] = null;
     if (queued) this.computeFrame(m.slot, queued.seq, queued.scale, queued.displacements);
@@ -500,7 +502,7 @@ export class EditorState {
       this.wholeShown = true;
       stats.meshShown = performance.now();
     }
-    if (this.firstDraw === 'shown' && this.viewer.whole) {
+    if (this.firstDraw === 'shown' && this.viewer.shaded) {
       this.firstDraw = 'drawn';
       stats.meshDrawn = performance.now();
       this.previewFrom = this.viewer.draws;
@@ -551,12 +553,12 @@ export class EditorState {
         bytes.set(value, end);
         end += value.length;
         for (let next; (next = P.decodeMeshPart(bytes.buffer, at, end)); at += next[1]) {
+          await this.meshPart(next[0]);
           if (performance.now() - task > kTaskMs) {
             await nextTask();
             if (fetching !== this.meshFetches) return void reader.cancel();
             task = performance.now();
           }
-          await this.meshPart(next[0]);
         }
       }
       if (at !== bytes.length) throw new Error(`${at} of ${bytes.length} bytes`);
@@ -604,7 +606,7 @@ export class EditorState {
     if (samePositions) return; // a reconnection: keep the view and what is shown
     this.rest = m.positions;
     const n = this.rest.length / 3;
-    this.viewer.setMesh(this.rest.slice(), m.indices, sameTriangles, shown);
+    this.viewer.setMesh(this.rest, m.indices, sameTriangles, shown);
     if (!sameTriangles) {
       // Another mesh: the selection goes (the server says so too), the preview is measured again
       // once it is drawn. It is painted while its basis is computed. What belonged to the old one
@@ -612,7 +614,6 @@ export class EditorState {
       this.onAnotherMesh();
       this.indices = m.indices;
       this.labels = new Int16Array(n);
-      this.colorBuffer = filled(n, FREE_COLOR); // as the view has it
       this.groups = [{ transform: new THREE.Matrix4(), pinned: false }];
       this.activeGroup = 0;
       this.previewWanted = false;
@@ -792,10 +793,11 @@ export class EditorState {
   // its radius from every handle vertex, along the edges; null when there is no region.
   private heldByInfluence(): Uint8Array | null {
     const radius = (this.ready?.settings.influence ?? 0) * this.diagonal;
-    const handles: number[] = [];
-    this.labels.forEach((l, v) => l >= 2 && handles.push(v));
     this.influenceHeld = 0;
-    if (!(radius > 0) || handles.length === 0) return null;
+    if (!(radius > 0)) return null;
+    const handles: number[] = [];
+    for (let v = 0; v < this.labels.length; ++v) if (this.labels[v] >= 2) handles.push(v);
+    if (handles.length === 0) return null;
     const held = new Uint8Array(this.labels.length).fill(1);
     for (const v of this.graph().geodesic(this.rest, handles, radius)) held[v] = 0;
     this.labels.forEach((l, v) => l === FREE && held[v] && ++this.influenceHeld);
@@ -806,7 +808,8 @@ export class EditorState {
   // drawn: a stroke moves its border).
   paint(vertices?: ArrayLike<number>): void {
     const n = this.labels.length;
-    const colors = this.colorBuffer.length === 3 * n ? this.colorBuffer : (this.colorBuffer = new Float32Array(3 * n));
+    const colors = this.viewer.colors;
+    if (colors.length !== 3 * n) return; // the view has another mesh (one arriving)
     const held = this.heldByInfluence();
     if (held) vertices = undefined;
     // Each label's colour as the buffer holds it (0 free, 1 fixed, 2 + g group g), then the
@@ -826,7 +829,7 @@ export class EditorState {
     }
     const heldAt = 3 * (top + 1);
     table.set([HELD_COLOR.r, HELD_COLOR.g, HELD_COLOR.b], heldAt);
-    let changed = false;
+    const changed: number[] = [];
     const count = vertices ? vertices.length : n;
     for (let i = 0; i < count; ++i) {
       const v = vertices ? vertices[i] : i;
@@ -835,13 +838,12 @@ export class EditorState {
       colors[3 * v] = table[k];
       colors[3 * v + 1] = table[k + 1];
       colors[3 * v + 2] = table[k + 2];
-      changed = true;
+      changed.push(v);
     }
     // The same colours again (the selection as the server confirms it) redraw nothing: a draw
     // of a million triangles costs a second of CPU without a GPU.
-    if (changed) this.viewer.setColors(colors, vertices);
+    if (changed.length > 0) this.viewer.colorsChanged(vertices ? Uint32Array.from(changed).sort() : changed);
   }
-  private colorBuffer = new Float32Array(0);
 }
 
 export const GROUP_HEX = [0xf28e2b, 0x59a14f, 0xb07aa1, 0x76b7b2, 0xedc948, 0xe15759, 0x9c755f];
@@ -853,12 +855,7 @@ export const PIN_HEX = 0x1f3b63;
 const PIN_COLOR = new THREE.Color(PIN_HEX);
 
 function diagonalOf(p: Float32Array): number {
-  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
-  for (let i = 0; i < p.length; ++i) {
-    lo[i % 3] = Math.min(lo[i % 3], p[i]);
-    hi[i % 3] = Math.max(hi[i % 3], p[i]);
-  }
-  return Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
+  return new THREE.Box3().setFromArray(p).getSize(new THREE.Vector3()).length() || 1;
 }
 
 export function rowMajor(m: THREE.Matrix4): P.Matrix {

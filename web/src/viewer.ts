@@ -46,7 +46,9 @@ export class Viewer {
   private readonly drawn = new THREE.BufferGeometry();
   private readonly gpu: Record<'position' | 'normal' | 'color' | 'index', GpuArray>;
   private readonly wireGeometry = new THREE.BufferGeometry();
-  private arriving = false; // the mesh's parts are coming: uploads keep to kUploadBytes a frame
+  // A new mesh's parts are coming, then its normals: uploads keep to kUploadBytes a task.
+  private arriving = false;
+  private arrivingSphere: THREE.Sphere | null = null; // its bounding sphere
   private hiddenMask: Uint8Array | null = null; // per vertex: hidden (H), with its triangles
   private readonly surface: THREE.Mesh;
   // Smooth with the vertex normals; flat (each triangle's own, no normals needed) while a mesh
@@ -164,7 +166,7 @@ export class Viewer {
   // `positions` and `indices` are the arrays the parts fill; read until setMesh.
   beginMesh(positions: Float32Array, indices: Uint32Array): void {
     const n = positions.length / 3;
-    this.arriving = true;
+    [this.arriving, this.uploaded, this.showFrame] = [true, false, null];
     this.renderer.resetState();
     this.gpu.position.set(positions);
     this.gpu.normal.fresh(new Float32Array(3 * n)); // not drawn until setPositions
@@ -177,10 +179,12 @@ export class Viewer {
     this.bvh = null;
     this.look.set(null);
     this.shading = 'flat';
+    // The smooth program compiled now, while the mesh comes: its first use waits for it.
+    this.surface.material = this.smooth;
+    this.renderer.compile(this.scene, this.camera);
     this.showSurface();
-    const sphere = new THREE.Sphere();
-    new THREE.Box3().setFromArray(positions).getBoundingSphere(sphere);
-    this.frameMesh(sphere);
+    this.arrivingSphere = new THREE.Box3().setFromArray(positions).getBoundingSphere(new THREE.Sphere());
+    this.frameMesh(this.arrivingSphere);
     this.uploadLater();
   }
 
@@ -197,19 +201,23 @@ export class Viewer {
   }
 
   // A new mesh; `keepCamera` for another pose of the same one; `arrived`: the mesh that
-  // beginMesh and addTriangles showed as it came. The viewer keeps both arrays (`positions`
-  // changes with each frame).
+  // beginMesh and addTriangles showed as it came. The view reads both arrays and never writes
+  // them (a frame brings arrays of its own: setPositions).
   setMesh(positions: Float32Array, indices: Uint32Array, keepCamera: boolean, arrived = false): void {
     const n = positions.length / 3;
     this.geometry.setIndex(new THREE.BufferAttribute(indices, 1));
     this.geometry.setAttribute('position', new THREE.BufferAttribute(positions, 3));
+    // An arrived mesh's colours and normals are the arrays its GPU buffers were filled from.
     const colors = this.geometry.getAttribute('color');
-    if (!colors || colors.count !== n) {
+    if (arrived) this.geometry.setAttribute('color', new THREE.BufferAttribute(this.gpu.color.array, 3));
+    else if (!colors || colors.count !== n) {
       this.geometry.setAttribute('color', new THREE.BufferAttribute(filled(n, this.freeColor), 3));
     }
-    this.geometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
-    this.geometry.computeBoundingSphere();
+    this.geometry.setAttribute('normal', new THREE.BufferAttribute(arrived ? this.gpu.normal.array : new Float32Array(3 * n), 3));
+    if (arrived && this.arrivingSphere) this.geometry.boundingSphere = this.arrivingSphere;
+    else this.geometry.computeBoundingSphere();
     this.renderer.resetState();
+    this.showFrame = null; // a frame of the old mesh on its way is dropped (set)
     this.gpu.position.set(positions, arrived);
     this.gpu.normal.set(this.normals(), true); // not drawn until setPositions uploads them
     this.gpu.color.set(this.geometry.getAttribute('color').array as Float32Array, arrived);
@@ -249,36 +257,69 @@ export class Viewer {
   // Changed GPU arrays go up before the next draw, or, while a mesh arrives, kUploadBytes a
   // task of its own (not a frame: a draw of the mesh coming would hold it); the view is drawn as they go.
   private uploadLater(): void {
-    if (!this.arriving) return this.changedContent();
+    const { position, normal, color, index } = this.gpu;
+    const frame = position.framePending || normal.framePending;
+    if (!this.arriving && !frame) return this.changedContent();
     if (this.uploadQueued) return;
     this.uploadQueued = true;
     setTimeout(() => {
       this.uploadQueued = false;
-      this.upload(kUploadBytes);
-      const left = Object.values(this.gpu).some((a) => a.pendingBytes > 0);
-      if (!left && this.geometry.index) { // setMesh came: arrived whole
+      if (this.drawing()) return this.uploadLater(); // an upload would wait behind the draw
+      this.upload(this.arriving ? kUploadBytes : Infinity, kUploadBytes);
+      // A frame is drawn once both of its arrays are there.
+      const ready = (a: GpuArray) => !a.framePending || a.frameReady;
+      const swap = (position.framePending || normal.framePending) && ready(position) && ready(normal);
+      if (swap) {
+        for (const a of [position, normal]) if (a.frameReady) a.swap();
+        this.bindDrawn();
+        this.showFrame?.();
+        this.showFrame = null;
+      }
+      const left = Object.values(this.gpu).some((a) => a.pendingBytes > 0 || a.framePending);
+      this.uploaded = this.geometry.index !== null && // setMesh came: arrived whole (flat)
+        position.pendingBytes + color.pendingBytes + index.pendingBytes === 0;
+      if (this.uploaded && this.shading === 'smooth' && !normal.framePending) { // and its normals
         this.arriving = false;
         this.showSurface();
       }
-      // Drawn now and then as it comes: each draw of it costs a software renderer as much as
-      // the whole mesh's.
-      if (!this.arriving || performance.now() - this.lastDraw > kArrivalDrawMs) this.changedContent();
+      // Drawn now and then as it comes (each draw of it costs a software renderer as much as the
+      // whole mesh's), a frame once it is there.
+      if (swap || (this.arriving ? performance.now() - this.lastDraw > kArrivalDrawMs : !left)) this.changedContent();
       if (left) this.uploadLater();
     });
   }
   private uploadQueued = false;
 
-  private upload(budget: number): void {
-    const arrays = Object.values(this.gpu).filter((a) => a.pendingBytes > 0);
+  // Whether the GPU (a software renderer's threads) is still on the last draw: a GL call made
+  // meanwhile may wait for it (most of a second for a large mesh without a GPU).
+  private drawing(): boolean {
+    const gl = this.renderer.getContext() as WebGL2RenderingContext;
+    if (!this.drawFence || gl.getSyncParameter(this.drawFence, gl.SYNC_STATUS) !== gl.SIGNALED) return this.drawFence !== null;
+    gl.deleteSync(this.drawFence);
+    this.drawFence = null;
+    return false;
+  }
+  private drawFence: WebGLSync | null = null; // after the last draw while a mesh arrives, until passed
+
+  // Uploads changed ranges, at most `budget` bytes, and of pending frames at most `frames`.
+  private upload(budget: number, frames = 0): void {
+    const arrays = Object.values(this.gpu).filter((a) => a.pendingBytes > 0 || (frames > 0 && a.framePending));
     if (arrays.length === 0) return;
     this.renderer.resetState(); // three.js's GL state: bound vertex arrays and buffers
     for (const a of arrays) budget -= a.flush(budget);
+    for (const a of arrays) frames -= a.flushFrame(frames);
+  }
+
+  // Whether the mesh is drawn shaded with its normals.
+  get shaded(): boolean {
+    return this.shading === 'smooth' && !this.arriving;
   }
 
   // Whether the mesh is drawn whole: all of it arrived and uploaded.
   get whole(): boolean {
-    return !this.arriving && this.geometry.index !== null;
+    return (this.uploaded || !this.arriving) && this.geometry.index !== null;
   }
+  private uploaded = false; // an arriving mesh is whole on the GPU
 
   positions(): Float32Array {
     return this.geometry.getAttribute('position').array as Float32Array;
@@ -325,55 +366,67 @@ export class Viewer {
   }
   private shading: 'none' | 'flat' | 'smooth' = 'none';
 
-  // A full frame: positions and their normals (computed off the main thread), and the file
-  // look's normals when it has one.
+  // A full frame: positions and their normals (computed off the main thread, the view's from
+  // here), and the file look's normals when it has one.
   setPositions(positions: Float32Array, normals: Float32Array, lookNormals: Float32Array | null = null): void {
     const p = this.geometry.getAttribute('position') as THREE.BufferAttribute;
     const nrm = this.geometry.getAttribute('normal') as THREE.BufferAttribute;
     // The same again (a frame at the rest shape while it is shown): nothing to upload or draw.
-    const same = this.shading === 'smooth' && !this.coarse.visible && equal(p.array as Float32Array, positions) &&
-      equal(nrm.array as Float32Array, normals) && (lookNormals === null || this.look.hasNormals(lookNormals));
-    this.previewLabel.hidden = true;
-    if (same) return this.requestRender(); // answered by onRendered, without a draw
     // The rest shape's first frame brings only its normals.
-    if (!equal(p.array as Float32Array, positions)) this.gpu.position.update(0, p.count);
-    (p.array as Float32Array).set(positions);
-    (nrm.array as Float32Array).set(normals);
-    this.gpu.normal.update(0, nrm.count);
-    this.bvhStale = true;
-    this.coarse.visible = false;
-    this.shading = 'smooth';
-    this.look.setPositions(positions, lookNormals);
-    this.showSurface();
+    const samePositions = equal(p.array as Float32Array, positions);
+    const same = samePositions && this.shading === 'smooth' && !this.coarse.visible &&
+      equal(nrm.array as Float32Array, normals) && (lookNormals === null || this.look.hasNormals(lookNormals));
+    if (same) {
+      this.previewLabel.hidden = true;
+      return this.requestRender(); // answered by onRendered, without a draw
+    }
+    // The frame's arrays are the view's from here (the worker made them). A large one goes up
+    // beside the drawn one, a task at a time (uploadLater), and is shown (the preview of a drag
+    // giving way to it) once it is all there.
+    const large = 4 * (samePositions ? 0 : positions.length) + 4 * normals.length > kUploadBytes;
+    const { position, normal } = this.gpu;
+    if (!samePositions) {
+      p.array = positions;
+      if (large) position.frame(positions);
+      else position.set(positions);
+    }
+    nrm.array = normals;
+    if (large) normal.frame(normals);
+    else normal.set(normals);
+    this.bvhStale ||= !samePositions; // refitted at the next pick (150 ms at 692k)
+    this.bindDrawn(); // set() makes new buffers where the length changed
+    const show = () => {
+      this.previewLabel.hidden = true;
+      this.coarse.visible = false;
+      this.shading = 'smooth';
+      this.look.setPositions(positions, lookNormals);
+      this.showSurface();
+    };
+    if (large) this.showFrame = show;
+    else show();
     this.uploadLater();
   }
+  private showFrame: (() => void) | null = null; // once the large frame on its way is all there
 
-  // Colours (3 floats per vertex) of the vertices listed, or of all.
-  setColors(colors: Float32Array, vertices?: ArrayLike<number>): void {
-    const attribute = this.geometry.getAttribute('color') as THREE.BufferAttribute;
-    const array = attribute.array as Float32Array;
-    if (!vertices) {
-      // Only the changed span goes up (the first paint of a mesh drawn in the free colour: none).
-      let lo = 0, hi = array.length;
-      while (lo < hi && array[lo] === colors[lo]) ++lo;
-      while (hi > lo && array[hi - 1] === colors[hi - 1]) --hi;
-      array.set(colors);
-      this.gpu.color.update(Math.floor(lo / 3), Math.ceil(hi / 3) - Math.floor(lo / 3));
-    } else {
-      let lo = Infinity, hi = -1;
-      for (let i = 0; i < vertices.length; ++i) {
-        const v = vertices[i];
-        array[3 * v] = colors[3 * v];
-        array[3 * v + 1] = colors[3 * v + 1];
-        array[3 * v + 2] = colors[3 * v + 2];
-        lo = Math.min(lo, v);
-        hi = Math.max(hi, v);
-      }
-      if (hi < 0) return;
-      this.gpu.color.update(lo, hi - lo + 1); // only the changed span is uploaded
+  // The vertices' colours (3 floats each), which the caller changes in place and then names
+  // (colorsChanged).
+  get colors(): Float32Array {
+    return this.geometry.getAttribute('color').array as Float32Array;
+  }
+
+  // The vertices listed (ascending), or all, took new colours: only their runs are uploaded,
+  // runs closer than kColorGap vertices as one (a stroke's vertices lie all over a large
+  // mesh's numbering: their whole span is megabytes).
+  colorsChanged(vertices?: ArrayLike<number>): void {
+    if (!vertices) this.gpu.color.update(0, this.colors.length / 3);
+    for (let i = 0; vertices && i < vertices.length;) {
+      let j = i + 1;
+      while (j < vertices.length && vertices[j] - vertices[j - 1] <= kColorGap) ++j;
+      this.gpu.color.update(vertices[i], vertices[j - 1] - vertices[i] + 1);
+      i = j;
     }
     this.syncCoarseColors();
-    this.look.setColors(array, this.freeColor);
+    this.look.setColors(this.colors, this.freeColor);
     this.uploadLater();
   }
 
@@ -669,6 +722,12 @@ export class Viewer {
       [this.shown, this.drawAgain] = [showing, false];
       if (!this.arriving) this.upload(Infinity);
       this.renderer.render(this.scene, this.view);
+      if (this.arriving) {
+        const gl = this.renderer.getContext() as WebGL2RenderingContext;
+        if (this.drawFence) gl.deleteSync(this.drawFence);
+        this.drawFence = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
+        gl.flush();
+      }
       this.lastDraw = performance.now();
       ++this.draws;
       // The full mesh's draws, timed one at a time, pace the next (a draw without it is quick).
@@ -791,7 +850,7 @@ export class Viewer {
 }
 
 // n colours, all `color`: a new mesh's, before it is painted.
-export function filled(n: number, color: THREE.Color): Float32Array<ArrayBuffer> {
+function filled(n: number, color: THREE.Color): Float32Array<ArrayBuffer> {
   const colors = new Float32Array(3 * n);
   if (n === 0) return colors;
   colors.set([color.r, color.g, color.b]);
@@ -807,10 +866,11 @@ function equal(a: Float32Array, b: Float32Array): boolean {
 
 // Draws slower than this are spaced out (requestRender).
 const kSlowDrawMs = 50;
-// Uploaded a frame while a mesh arrives: 4 MB, tens of milliseconds of the page's thread on a
+// Uploaded a task while a mesh arrives: 1 MB, tens of milliseconds of the page's thread on a
 // software renderer with the server's basis computing beside it.
-const kUploadBytes = 4 << 20;
-const kArrivalDrawMs = 1e9; // a mesh coming is drawn this often at most
+const kUploadBytes = 1 << 20;
+const kArrivalDrawMs = 500;
+const kColorGap = 64; // vertices between two painted runs uploaded as one // a mesh coming is drawn this often at most
 
 // The renderer, without multisampling where the context is a software renderer (no GPU: it
 // would spend most of a frame on it), with it otherwise. One context is made there (a second
