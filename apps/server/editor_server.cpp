@@ -9,6 +9,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <random>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -148,11 +149,16 @@ struct EditorServer::Impl {
   // The mesh's notice (and its look) whose basis is computed: binary or not, and the message.
   std::vector<std::pair<bool, std::string>> preparing;
   // The mesh's parts (101) do not go over the socket: they are gathered into one body that the
-  // page fetches (GET /mesh/ID, as the text message {"type": "mesh", "id", "bytes"} says), in a
-  // fraction of the time a WebSocket takes to carry the 25 MB of a 692k mesh into a browser.
-  std::string mesh_parts;                   // of the mesh being sent
-  uint64_t mesh_id = 0;                     // the last whole one's
-  std::shared_ptr<const std::string> mesh;  // its parts, one after the other
+  // page fetches (GET /mesh/ID, as the text message {"type": "mesh", "id", "bytes"} says, or
+  // /mesh/latest as it starts), in a fraction of the time a WebSocket takes to carry the 25 MB
+  // of a 692k mesh into a browser.
+  std::string mesh_parts;  // of the mesh being sent
+  // The last whole one's id (unique to this run: a page that reconnects to another server run
+  // does not take a mesh for one it has) and its parts, one after the other.
+  const std::string mesh_run = std::to_string(std::random_device{}());
+  int mesh_count = 0;
+  std::string mesh_id;
+  std::shared_ptr<const std::string> mesh;
 
   void send(bool binary, std::string data) {
     std::shared_ptr<Connection> c;
@@ -180,8 +186,9 @@ struct EditorServer::Impl {
     std::memcpy(header, part.data(), sizeof header);
     if (header[3] != 1 || header[4] + header[5] != header[2]) return std::nullopt;
     mesh = std::make_shared<const std::string>(std::exchange(mesh_parts, {}));
-    return R"({"bytes":)" + std::to_string(mesh->size()) + R"(,"id":)" + std::to_string(++mesh_id) +
-           R"(,"type":"mesh"})";
+    mesh_id = mesh_run + "-" + std::to_string(++mesh_count);
+    return R"({"bytes":)" + std::to_string(mesh->size()) + R"(,"id":")" + mesh_id +
+           R"(","type":"mesh"})";
   }
 
   // The mesh's notice (and look) sent before its basis, for a window that connects while the
@@ -247,12 +254,17 @@ struct EditorServer::Impl {
     target = target.substr(0, target.find_first_of("?#"));
     if (target.starts_with("/mesh/")) {
       std::shared_ptr<const std::string> body;
+      std::string id;
       {
         std::lock_guard lock(connection_mutex);
-        if (target == "/mesh/" + std::to_string(mesh_id)) body = mesh;
+        if (target == "/mesh/" + mesh_id || (mesh && target == "/mesh/latest")) {
+          std::tie(body, id) = std::pair(mesh, mesh_id);
+        }
       }
       if (!body) return reply(req, http::status::not_found, "not the open mesh\n", "text/plain");
-      return reply(req, http::status::ok, *body, "application/octet-stream");
+      auto res = reply(req, http::status::ok, *body, "application/octet-stream");
+      res.set("X-Mesh-Id", id);
+      return res;
     }
     const auto it = assets.find(target);
     if (it == assets.end()) return reply(req, http::status::not_found, "not found\n", "text/plain");

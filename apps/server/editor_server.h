@@ -5,8 +5,9 @@
 //   server (no DNS rebinding) and WebSocket upgrades whose Origin is the server's own page.
 // - Serves exactly the files found under the assets folder at start-up, read into memory, and
 //   nothing else (no path traversal, no symbolic links followed); and the open mesh's parts
-//   (protocol.h, 101) at /mesh/ID, which the socket's {"type": "mesh", "id", "bytes"} names:
-//   a browser takes 25 MB several times faster over HTTP than over a WebSocket.
+//   (protocol.h, 101) at /mesh/ID, which the socket's {"type": "mesh", "id", "bytes"} names,
+//   and at /mesh/latest (its id in X-Mesh-Id) for a page that starts: a browser takes 25 MB
+//   several times faster over HTTP than over a WebSocket, and while it makes its view.
 // - One editor window at a time: a new connection takes over and the previous one is closed.
 // - A "cancel" message is acted on as it arrives (EditorSession::cancel), not queued; a window
 //   that connects while the basis is computed gets the latest progress at once.

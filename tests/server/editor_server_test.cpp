@@ -119,10 +119,14 @@ TEST_F(EditorServerTest, ServesOnlyTheBuiltAssets) {
 TEST_F(EditorServerTest, ServesTheOpenMeshAsItsNoticeSays) {
   auto ws = connect(own_origin());
   const nlohmann::json notice = read_until(*ws, "mesh");
-  const std::string id = std::to_string(notice["id"].get<uint64_t>());
+  const std::string id = notice["id"];
   const auto res = get("/mesh/" + id);
   ASSERT_EQ(res.result(), http::status::ok);
   EXPECT_EQ(res[http::field::content_type], "application/octet-stream");
+  EXPECT_EQ(res["X-Mesh-Id"], id);
+  const auto latest = get("/mesh/latest");  // what a page fetches as it starts
+  EXPECT_EQ(latest["X-Mesh-Id"], id);
+  EXPECT_EQ(latest.body(), res.body());
   const std::string& body = res.body();
   ASSERT_EQ(body.size(), notice["bytes"].get<size_t>());
   ASSERT_TRUE(starts_mesh(body));
@@ -136,8 +140,7 @@ TEST_F(EditorServerTest, ServesTheOpenMeshAsItsNoticeSays) {
   EXPECT_EQ(at, body.size());
   EXPECT_EQ(vertices, 162u);
   EXPECT_EQ(triangles, 320u);
-  EXPECT_EQ(get("/mesh/" + std::to_string(notice["id"].get<uint64_t>() + 1)).result(),
-            http::status::not_found);
+  EXPECT_EQ(get("/mesh/" + id + "0").result(), http::status::not_found);
   EXPECT_EQ(get("/mesh/" + id, "evil.example:80").result(), http::status::forbidden);
 }
 

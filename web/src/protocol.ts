@@ -107,10 +107,10 @@ export type ServerText =
   | { type: 'saving'; file: string; done: boolean; seconds?: number; bytes?: number; error?: string };
 
 // A mesh to fetch (apps/server/editor_server.h): GET /mesh/ID, its parts (101) one after the
-// other, `bytes` in all.
+// other, `bytes` in all; /mesh/latest serves the last one, its id in X-Mesh-Id.
 export interface MeshNotice {
   type: 'mesh';
-  id: number;
+  id: string;
   bytes: number;
 }
 

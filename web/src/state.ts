@@ -124,6 +124,7 @@ export class EditorState {
       binary: (b) => this.receive(() => this.onBinary(b), false),
     };
     this.worker.onmessage = (e: MessageEvent<WorkerReply>) => this.onWorker(e.data);
+    void this.fetchMesh(null);
     viewer.onRendered = () => this.onRendered();
     viewer.onDrawTimed = (ms, draw) => this.drawTimed(ms, draw);
   }
@@ -534,35 +535,44 @@ export class EditorState {
     return a.mesh && !a.whole ? { bytes: a.bytes, total: a.totalBytes } : null;
   }
 
-  // Fetches the mesh the server names and takes its parts as they come, a task at a time (a
-  // newer one's fetch drops it); the socket's other messages wait meanwhile.
-  private async fetchMesh(m: P.MeshNotice): Promise<void> {
+  // Fetches a mesh and takes its parts as they come, a task at a time (a newer fetch drops it);
+  // the socket's other messages wait meanwhile. Without a notice: the latest mesh, fetched as
+  // the page starts, so that its bytes come while the page makes its view (seconds without a
+  // GPU); a notice of the mesh fetched, or on its way, fetches nothing.
+  private async fetchMesh(m: P.MeshNotice | null): Promise<void> {
+    if (m && (await this.meshId) === m.id) return;
     const fetching = ++this.meshFetches;
     this.waiting ??= [];
+    let named = (_: string | null) => {};
+    this.meshId = new Promise((resolve) => (named = resolve));
     try {
-      const response = await fetch(`/mesh/${m.id}`);
-      if (!response.ok || !response.body) throw new Error(`${response.status} ${response.statusText}`);
-      const reader = response.body.getReader();
-      const bytes = new Uint8Array(m.bytes);
-      let [end, at, task] = [0, 0, performance.now()];
-      for (;;) {
-        const { done, value } = await reader.read();
-        if (fetching !== this.meshFetches) return void reader.cancel();
-        if (done) break;
-        if (end + value.length > bytes.length) throw new Error('more bytes than announced');
-        bytes.set(value, end);
-        end += value.length;
-        for (let next; (next = P.decodeMeshPart(bytes.buffer, at, end)); at += next[1]) {
-          await this.meshPart(next[0]);
-          if (performance.now() - task > kTaskMs) {
-            await nextTask();
-            if (fetching !== this.meshFetches) return void reader.cancel();
-            task = performance.now();
+      const response = await fetch(m ? `/mesh/${m.id}` : '/mesh/latest');
+      named(response.ok ? response.headers.get('X-Mesh-Id') : null);
+      if (m || response.status !== 404) { // without a notice, none may be open yet
+        if (!response.ok || !response.body) throw new Error(`${response.status} ${response.statusText}`);
+        const reader = response.body.getReader();
+        const bytes = new Uint8Array(Number(response.headers.get('Content-Length')));
+        let [end, at, task] = [0, 0, performance.now()];
+        for (;;) {
+          const { done, value } = await reader.read();
+          if (fetching !== this.meshFetches) return void reader.cancel();
+          if (done) break;
+          if (end + value.length > bytes.length) throw new Error('more bytes than announced');
+          bytes.set(value, end);
+          end += value.length;
+          for (let next; (next = P.decodeMeshPart(bytes.buffer, at, end)); at += next[1]) {
+            await this.meshPart(next[0]);
+            if (performance.now() - task > kTaskMs) {
+              await nextTask();
+              if (fetching !== this.meshFetches) return void reader.cancel();
+              task = performance.now();
+            }
           }
         }
+        if (at !== bytes.length) throw new Error(`${at} of ${bytes.length} bytes`);
       }
-      if (at !== bytes.length) throw new Error(`${at} of ${bytes.length} bytes`);
     } catch (e) {
+      named(null);
       if (fetching !== this.meshFetches) return;
       this.arrival.mesh = null;
       this.note(`the mesh did not arrive: ${e instanceof Error ? e.message : e}`, 'error');
@@ -572,6 +582,7 @@ export class EditorState {
     for (const handle of waiting) handle();
     this.changed();
   }
+  private meshId: Promise<string | null> | null = null; // of the last fetch, once it answered
   private meshFetches = 0;
 
   // Takes a part; the last one's mesh is taken in a few tasks (the promise).
