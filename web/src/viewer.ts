@@ -414,17 +414,19 @@ export class Viewer {
     return this.geometry.getAttribute('color').array as Float32Array;
   }
 
-  // The vertices listed (ascending), or all, took new colours: only their runs are uploaded,
-  // runs closer than kColorGap vertices as one (a stroke's vertices lie all over a large
-  // mesh's numbering: their whole span is megabytes).
-  colorsChanged(vertices?: ArrayLike<number>): void {
-    if (!vertices) this.gpu.color.update(0, this.colors.length / 3);
-    for (let i = 0; vertices && i < vertices.length;) {
+  // The vertices listed (ascending) took new colours: only their runs are uploaded, runs
+  // closer than kColorGap vertices as one (a stroke's vertices lie all over a large mesh's
+  // numbering: their whole span is megabytes), and their whole span past kColorRuns runs.
+  colorsChanged(vertices: ArrayLike<number>): void {
+    const runs: [number, number][] = [];
+    for (let i = 0; i < vertices.length;) {
       let j = i + 1;
       while (j < vertices.length && vertices[j] - vertices[j - 1] <= kColorGap) ++j;
-      this.gpu.color.update(vertices[i], vertices[j - 1] - vertices[i] + 1);
+      runs.push([vertices[i], vertices[j - 1] - vertices[i] + 1]);
       i = j;
     }
+    if (runs.length > kColorRuns) runs.splice(0, Infinity, [vertices[0], vertices[vertices.length - 1] - vertices[0] + 1]);
+    for (const [first, count] of runs) this.gpu.color.update(first, count);
     this.syncCoarseColors();
     this.look.setColors(this.colors, this.freeColor);
     this.uploadLater();
@@ -870,7 +872,8 @@ const kSlowDrawMs = 50;
 // software renderer with the server's basis computing beside it.
 const kUploadBytes = 1 << 20;
 const kArrivalDrawMs = 500;
-const kColorGap = 64; // vertices between two painted runs uploaded as one // a mesh coming is drawn this often at most
+const kColorGap = 64; // vertices between two painted runs uploaded as one
+const kColorRuns = 1024; // runs uploaded one by one at most // a mesh coming is drawn this often at most
 
 // The renderer, without multisampling where the context is a software renderer (no GPU: it
 // would spend most of a frame on it), with it otherwise. One context is made there (a second
