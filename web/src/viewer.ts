@@ -143,8 +143,8 @@ export class Viewer {
     this.resize();
     this.bvhWorker.onmessage = (e: MessageEvent<BvhReply>) => {
       if (e.data.id !== this.bvhRequest || this.bvh) return;
+      // Built on the rest shape: refitted at the next pick if a frame moved it since (bvhStale).
       this.bvh = MeshBVH.deserialize(e.data.bvh, this.geometry, { setIndex: false });
-      this.bvhStale = true; // the positions may have moved since
     };
   }
 
