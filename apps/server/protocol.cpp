@@ -315,13 +315,14 @@ std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& 
   // scaled up to the int16 range they would read as one.
   if (largest <= kRoundingNoise * extent) largest = 0.0;
   const float scale = largest > 0.0 ? static_cast<float>(largest / 32767.0) : 1.0f;
+  const bool at_rest = largest == 0.0;  // no displacements follow
   Writer w;
-  w.reserve(52 + 6 * n + 2);
+  w.reserve(52 + (at_rest ? 0 : 6 * n + 2));
   w.put(static_cast<uint32_t>(Tag::FrameResult));
   w.put(seq);
   w.put(static_cast<uint32_t>(n));
   w.put(static_cast<uint32_t>((view.base ? 1 : 0) | (subset ? 2 : 0) |
-                              (stats.fold_zone > 0 ? 4 : 0)));
+                              (stats.fold_zone > 0 ? 4 : 0) | (at_rest ? 8 : 0)));
   for (double ms : {stats.reduced_solve, stats.inverse_transform, stats.detail, stats.total}) {
     w.put(static_cast<float>(ms * 1e3));
   }
@@ -330,7 +331,7 @@ std::string encode_frame_result(uint32_t seq, FrameView view, const FrameStats& 
   w.put(static_cast<uint32_t>(stats.arap_iterations));
   w.put(uint32_t{stats.arap_converged ? 1u : 0u});
   w.put(scale);
-  for (size_t i = 0; i < n; ++i) {
+  for (size_t i = 0; i < (at_rest ? 0 : n); ++i) {
     for (int k = 0; k < 3; ++k) {
       const double d = (positions(i, k) - rest(vertex(i), k)) / scale;
       w.put(static_cast<int16_t>(std::clamp(std::lround(d), -32767L, 32767L)));
@@ -350,10 +351,12 @@ Vertices decode_frame_positions(std::string_view message, const Vertices& rest,
   if (!subset && n != rest.rows()) r.fail("not this mesh's");
   r.bytes(32);
   const float scale = r.get<float>();
+  const bool at_rest = (view & 8) != 0;
   Vertices out(n, 3);
   for (uint32_t i = 0; i < n; ++i) {
     const Eigen::Index v = subset ? preview->vertices[i] : i;
-    for (int k = 0; k < 3; ++k) out(i, k) = rest(v, k) + scale * r.get<int16_t>();
+    for (int k = 0; k < 3; ++k)
+      out(i, k) = rest(v, k) + (at_rest ? 0.0f : scale * r.get<int16_t>());
   }
   r.align4();
   r.expect_end();

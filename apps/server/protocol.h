@@ -27,7 +27,8 @@
 //                  server gathers the parts and the page fetches them over HTTP
 //                  (editor_server.h), not over the socket
 //   102 frame      u32 tag | u32 seq | u32 n | u32 view (bit 0: smooth base, bit 1: preview,
-//                  bit 2: the smooth base folded, details added as displacements there) |
+//                  bit 2: the smooth base folded, details added as displacements there,
+//                  bit 3: at rest, no displacements follow: 4 MB less at 692k) |
 //                  f32 reduced solve, inverse transform, detail, total (ms) |
 //                  f32 the smooth base's miss of its targets, max, rms (over the bounding-box
 //                  diagonal: SpectralDeformer::base_miss) |

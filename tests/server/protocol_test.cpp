@@ -155,15 +155,18 @@ TEST(Protocol, MeshAndFrameResultLayouts) {
   EXPECT_NEAR(back(0, 2), moved(2, 2), 0.5 / 32767);
   EXPECT_NEAR(back(1, 0), moved(1, 0), 0.5 / 32767);
   EXPECT_EQ(encode_preview(preview).size(), 12u + 8u);
-  // A solve at the rest pose differs from it by rounding only: sent as no motion (scale 1, every
-  // displacement 0), not rounding scaled up to the int16 range.
+  // A solve at the rest pose differs from it by rounding only: sent as no motion (scale 1, bit
+  // 3: at rest, no displacements follow), not rounding scaled up to the int16 range.
   Vertices noise = m.V;
   noise(1, 0) += 3e-15;
   noise(2, 1) -= 1e-15;
   const std::string still = encode_frame_result(5, {}, {}, noise, m.V);
+  EXPECT_EQ(still.size(), 52u);
   float scale = 0;
   std::memcpy(&scale, still.data() + 48, 4);
   EXPECT_EQ(scale, 1.0f);
+  std::memcpy(&view, still.data() + 12, 4);
+  EXPECT_EQ(view, 8u);
   EXPECT_EQ(decode_frame_positions(still, m.V), m.V);
   EXPECT_THROW(message_tag("ab"), InputError);
 }

@@ -306,7 +306,8 @@ export function decodeFrameResult(buffer: ArrayBuffer): FrameResult {
     error: { max: f[4], rms: f[5] },
     arap: { iterations: u[10], converged: u[11] === 1 },
     scale: new Float32Array(buffer, 48, 1)[0],
-    displacements: new Int16Array(buffer, 52, 3 * u[2]),
+    // At rest (bit 3) none follow: zeros.
+    displacements: u[3] & 8 ? new Int16Array(3 * u[2]) : new Int16Array(buffer, 52, 3 * u[2]),
   };
 }
 
