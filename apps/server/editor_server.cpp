@@ -182,9 +182,8 @@ struct EditorServer::Impl {
   std::optional<std::string> gather_mesh(const std::string& part) {
     if (starts_mesh(part)) mesh_parts.clear();
     mesh_parts += part;
-    uint32_t header[6];  // tag, n, T, kind, first, count
-    std::memcpy(header, part.data(), sizeof header);
-    if (header[3] != 1 || header[4] + header[5] != header[2]) return std::nullopt;
+    const MeshPartHeader h = mesh_part_header(part);
+    if (h.kind != 1 || h.first + h.count != h.triangles) return std::nullopt;
     mesh = std::make_shared<const std::string>(std::exchange(mesh_parts, {}));
     mesh_id = mesh_run + "-" + std::to_string(++mesh_count);
     return R"({"bytes":)" + std::to_string(mesh->size()) + R"(,"id":")" + mesh_id +

@@ -48,6 +48,11 @@ constexpr int kPoseBases = 3;
 // The basis is computed at this nice value (Linux), as the transfer's factorisation is.
 constexpr int kBasisNice = 5;
 
+// Lowers the calling thread's priority (and that of the threads it starts) to `nice`.
+void lower_this_thread(int nice) {
+  setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), nice);
+}
+
 std::string hex(uint64_t v) {
   char s[17];
   std::snprintf(s, sizeof s, "%016llx", static_cast<unsigned long long>(v));
@@ -675,8 +680,7 @@ PreparedBasis EditorSession::compute_basis(const TriangleMesh& mesh, int modes) 
   // the cores (the 25 MB of a 692k mesh arrived in 3.2 s beside it at the same priority).
   return std::async(std::launch::async,
                     [&] {
-                      setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)),
-                                  kBasisNice);
+                      lower_this_thread(kBasisNice);
                       return prepare_basis(mesh, modes, solver, config_.cache_dir, report);
                     })
       .get();
@@ -746,7 +750,7 @@ void EditorSession::save_in_background() {
         // at most. At the lowest (19) a thread gets about 1.5% of one beside busy programs (the
         // transfer's did: detail_reconstruction.cpp), and twice in 14 runs of the loading e2e test
         // a 35 MB save had not reported after two minutes.
-        setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 10);
+        lower_this_thread(10);
         send_(false, dump(save_and_report(file, *basis, mesh)));
       });
 }

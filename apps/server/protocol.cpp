@@ -226,12 +226,20 @@ std::vector<std::string> encode_mesh_parts(const TriangleMesh& mesh, uint32_t pa
   return parts;
 }
 
+MeshPartHeader mesh_part_header(std::string_view message) {
+  Reader r(message, "mesh part");
+  r.bytes(4);
+  MeshPartHeader h{};
+  for (uint32_t* field : {&h.n, &h.triangles, &h.kind, &h.first, &h.count}) {
+    *field = r.get<uint32_t>();
+  }
+  return h;
+}
+
 bool starts_mesh(std::string_view message) {
-  uint32_t kind = 1, first = 1;
-  if (message_tag(message) != Tag::Mesh || message.size() < 24) return false;
-  std::memcpy(&kind, message.data() + 12, 4);
-  std::memcpy(&first, message.data() + 16, 4);
-  return kind == 0 && first == 0;
+  if (message.size() < 24 || message_tag(message) != Tag::Mesh) return false;
+  const MeshPartHeader h = mesh_part_header(message);
+  return h.kind == 0 && h.first == 0;
 }
 
 std::string encode_preview(const PreviewMesh& preview) {

@@ -154,6 +154,13 @@ std::string encode_file(const NamedFile& file, Tag tag = Tag::File);
 inline constexpr uint32_t kMeshPartItems = 1u << 16;
 std::vector<std::string> encode_mesh_parts(const TriangleMesh& mesh,
                                            uint32_t part_items = kMeshPartItems);
+// A 101 message's header; throws InputError if it is shorter than one.
+struct MeshPartHeader {
+  uint32_t n, triangles;
+  uint32_t kind;  // 0: positions, 1: triangles
+  uint32_t first, count;
+};
+MeshPartHeader mesh_part_header(std::string_view message);
 // Whether a 101 message is a mesh's first part (its positions from vertex 0).
 bool starts_mesh(std::string_view message);
 std::string encode_preview(const PreviewMesh& preview);

@@ -130,12 +130,11 @@ TEST_F(EditorServerTest, ServesTheOpenMeshAsItsNoticeSays) {
   const std::string& body = res.body();
   ASSERT_EQ(body.size(), notice["bytes"].get<size_t>());
   ASSERT_TRUE(starts_mesh(body));
-  std::vector<uint32_t> header(6);
   size_t at = 0, vertices = 0, triangles = 0;
-  for (; at + 24 <= body.size(); at += 24 + 12 * header[5]) {
-    std::memcpy(header.data(), body.data() + at, 24);
-    EXPECT_EQ(header[0], static_cast<uint32_t>(Tag::Mesh));
-    (header[3] == 0 ? vertices : triangles) += header[5];
+  for (; at + 24 <= body.size(); at += 24 + 12 * mesh_part_header(body.substr(at)).count) {
+    EXPECT_EQ(message_tag(body.substr(at)), Tag::Mesh);
+    const MeshPartHeader h = mesh_part_header(body.substr(at));
+    (h.kind == 0 ? vertices : triangles) += h.count;
   }
   EXPECT_EQ(at, body.size());
   EXPECT_EQ(vertices, 162u);

@@ -104,13 +104,12 @@ class EditorSessionTest : public ::testing::Test {
     Vertices V(rest_.rows(), 3);
     for (auto it = std::prev(start.base()); it != sent_.end(); ++it) {
       if (!it->binary || message_tag(it->data) != Tag::Mesh) continue;
-      uint32_t header[6];
-      std::memcpy(header, it->data.data(), sizeof header);
-      if (header[3] != 0) continue;  // triangles
-      for (uint32_t i = 0; i < 3 * header[5]; ++i) {
+      const MeshPartHeader h = mesh_part_header(it->data);
+      if (h.kind != 0) continue;  // triangles
+      for (uint32_t i = 0; i < 3 * h.count; ++i) {
         float x = 0;
         std::memcpy(&x, it->data.data() + 24 + 4 * i, 4);
-        V(header[4] + i / 3, i % 3) = x;
+        V(h.first + i / 3, i % 3) = x;
       }
     }
     return V;

@@ -42,7 +42,7 @@ export class Viewer {
   readonly scene = new THREE.Scene();
   private readonly geometry = new THREE.BufferGeometry(); // every triangle: picking, positions
   // What is drawn: the same vertex arrays and the shown triangles, in buffers filled a part at a
-  // time (gpu.ts), at most kUploadBytes a frame while a mesh arrives; the wireframe's own.
+  // time (gpu.ts), at most kUploadBytes a task while a mesh arrives; the wireframe's own.
   private readonly drawn = new THREE.BufferGeometry();
   private readonly gpu: Record<'position' | 'normal' | 'color' | 'index', GpuArray>;
   private readonly wireGeometry = new THREE.BufferGeometry();
