@@ -264,9 +264,10 @@ try {
   const longTasks = await api(() => window.longTasks);
   result.long_tasks_s = longTasks.sort((a, b) => b[1] - a[1]).slice(0, 8)
     .map(([t, d]) => [+(t / 1000).toFixed(2), +(d / 1000).toFixed(2)]);
-  // From the mesh's first byte to the first drag (its press): the page answers throughout.
+  // From the mesh's first part to the first drag (its press), a task that took the first part
+  // included: the page answers throughout.
   result.longest_task_to_drag_s = +(Math.max(0, ...longTasks
-    .filter(([t]) => t >= arrival.meshStarted && t < result.drag_started_s * 1000).map(([, d]) => d)) / 1000).toFixed(3);
+    .filter(([t, d]) => t + d > arrival.meshStarted && t < result.drag_started_s * 1000).map(([, d]) => d)) / 1000).toFixed(3);
   check(result.longest_task_to_drag_s < kLongestTaskS,
     `no task holds the page ${kLongestTaskS} s from the mesh's first part to the first drag (${result.longest_task_to_drag_s} s)`);
   result.messages_s = messages.filter(([t]) => t <= result.first_drag_drawn_s + 0.5);

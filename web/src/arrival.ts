@@ -6,6 +6,8 @@ import type { MeshPart } from './protocol';
 export interface WholeMesh {
   positions: Float32Array<ArrayBuffer>; // 3 n
   indices: Uint32Array<ArrayBuffer>; // 3 T
+  low: number[]; // the positions' bounding box, [x, y, z] (of those come so far)
+  high: number[];
 }
 
 export class MeshArrival {
@@ -18,7 +20,8 @@ export class MeshArrival {
   add(p: MeshPart): 'positions' | 'mesh' | null {
     const positionsPart = p.kind === 'positions';
     if (positionsPart && p.first === 0) {
-      this.mesh = { positions: new Float32Array(3 * p.n), indices: new Uint32Array(3 * p.triangles) };
+      this.mesh = { positions: new Float32Array(3 * p.n), indices: new Uint32Array(3 * p.triangles),
+        low: [Infinity, Infinity, Infinity], high: [-Infinity, -Infinity, -Infinity] };
       [this.vertices, this.triangles] = [0, 0];
     }
     const m = this.mesh;
@@ -29,8 +32,10 @@ export class MeshArrival {
     }
     target.set(p.data, 3 * p.first);
     const count = p.data.length / 3;
-    if (positionsPart) this.vertices += count;
-    else this.triangles += count;
+    if (positionsPart) {
+      bound(m, p.data as Float32Array);
+      this.vertices += count;
+    } else this.triangles += count;
     if (this.whole) return 'mesh';
     return positionsPart && 3 * this.vertices === m.positions.length ? 'positions' : null;
   }
@@ -46,6 +51,19 @@ export class MeshArrival {
 
   get totalBytes(): number {
     return this.mesh ? 4 * (this.mesh.positions.length + this.mesh.indices.length) : 0;
+  }
+}
+
+// Widens the mesh's bounding box to the positions (3 floats each): a part at a time, as the page's
+// one pass over a large mesh held it.
+function bound(m: WholeMesh, positions: Float32Array): void {
+  const { low, high } = m;
+  for (let i = 0; i < positions.length; i += 3) {
+    for (let k = 0; k < 3; ++k) {
+      const x = positions[i + k];
+      if (x < low[k]) low[k] = x;
+      if (x > high[k]) high[k] = x;
+    }
   }
 }
 

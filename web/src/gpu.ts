@@ -1,4 +1,4 @@
-// An array of the drawn surface (positions, normals, colours or triangles) in a WebGL buffer made
+// An array of the drawn surface (positions, normals, colours as bytes or triangles) in a WebGL buffer made
 // here and filled a range at a time. three.js's own attributes upload a whole array in one call:
 // 25 MB at 692k vertices, most of a second of the page's thread on a software renderer while the
 // server computes a basis beside it. Changed ranges wait for `flush`, which uploads at most a
@@ -6,7 +6,7 @@
 // frame goes to a second buffer meanwhile (`frame`), drawn once it is all there.
 import * as THREE from 'three';
 
-export type GpuTypedArray = Float32Array | Uint32Array;
+export type GpuTypedArray = Float32Array | Uint32Array | Uint8Array;
 
 export class GpuArray {
   attribute: THREE.GLBufferAttribute;
@@ -65,10 +65,11 @@ export class GpuArray {
       gl.bindBuffer(this.target, this.back);
       gl.bufferData(this.target, this.array.byteLength, gl.DYNAMIC_DRAW);
     }
-    const stop = Math.min(this.array.length, this.backDone + Math.max(1, Math.floor(budget / 4)));
+    const size = this.array.BYTES_PER_ELEMENT;
+    const stop = Math.min(this.array.length, this.backDone + Math.max(1, Math.floor(budget / size)));
     gl.bindBuffer(this.target, this.back);
-    gl.bufferSubData(this.target, 4 * this.backDone, this.array, this.backDone, stop - this.backDone);
-    const bytes = 4 * (stop - this.backDone);
+    gl.bufferSubData(this.target, size * this.backDone, this.array, this.backDone, stop - this.backDone);
+    const bytes = size * (stop - this.backDone);
     this.backDone = stop;
     return bytes;
   }
@@ -85,7 +86,8 @@ export class GpuArray {
   // The frame all there is drawn from here: a new `attribute`.
   swap(): void {
     [this.buffer, this.back, this.backDone] = [this.back, this.buffer, -1];
-    this.attribute = new THREE.GLBufferAttribute(this.buffer!, this.attribute.type, this.itemSize, 4, this.attribute.count);
+    const a = this.attribute;
+    this.attribute = new THREE.GLBufferAttribute(this.buffer!, a.type, a.itemSize, a.elementSize, a.count, a.normalized);
   }
 
   // The attribute as a geometry takes it: three.js draws a GLBufferAttribute where a
@@ -95,7 +97,7 @@ export class GpuArray {
   }
 
   get pendingBytes(): number {
-    return this.pending.reduce((sum, [b, e]) => sum + 4 * (e - b), 0);
+    return this.pending.reduce((sum, [b, e]) => sum + this.array.BYTES_PER_ELEMENT * (e - b), 0);
   }
 
   // Uploads pending ranges in order, at most `budget` bytes (the rest waits for the next call);
@@ -103,12 +105,13 @@ export class GpuArray {
   flush(budget: number): number {
     let done = 0;
     const gl = this.gl;
+    const size = this.array.BYTES_PER_ELEMENT;
     gl.bindBuffer(this.target, this.buffer);
     while (this.pending.length > 0 && done < budget) {
       const [begin, end] = this.pending[0];
-      const stop = Math.min(end, begin + Math.max(1, Math.floor((budget - done) / 4)));
-      gl.bufferSubData(this.target, 4 * begin, this.array, begin, stop - begin);
-      done += 4 * (stop - begin);
+      const stop = Math.min(end, begin + Math.max(1, Math.floor((budget - done) / size)));
+      gl.bufferSubData(this.target, size * begin, this.array, begin, stop - begin);
+      done += size * (stop - begin);
       if (stop === end) this.pending.shift();
       else this.pending[0][0] = stop;
     }
@@ -123,7 +126,9 @@ export class GpuArray {
     this.buffer = gl.createBuffer();
     gl.bindBuffer(this.target, this.buffer);
     gl.bufferData(this.target, array.byteLength, gl.DYNAMIC_DRAW);
-    const type = array instanceof Float32Array ? gl.FLOAT : gl.UNSIGNED_INT;
-    return new THREE.GLBufferAttribute(this.buffer!, type, this.itemSize, 4, array.length / this.itemSize);
+    // Bytes are colours, normalised to [0, 1] as the shader reads them.
+    const type = array instanceof Float32Array ? gl.FLOAT : array instanceof Uint8Array ? gl.UNSIGNED_BYTE : gl.UNSIGNED_INT;
+    const size = array.BYTES_PER_ELEMENT as 1 | 4;
+    return new THREE.GLBufferAttribute(this.buffer!, type, this.itemSize, size, array.length / this.itemSize, size === 1);
   }
 }

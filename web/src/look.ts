@@ -27,6 +27,12 @@ function drawLabels(shader: THREE.WebGLProgramParametersWithUniforms): void {
   diffuseColor.rgb = mix(diffuseColor.rgb, vLabel.rgb * (1.0 - 0.5 * stripe), vLabel.a);`);
 }
 
+// A colour as the mesh vertices' colours hold it: 3 bytes, 255 for 1 (in three.js's working
+// colour space, linear).
+export function colorBytes(c: THREE.Color): [number, number, number] {
+  return [Math.round(255 * c.r), Math.round(255 * c.g), Math.round(255 * c.b)];
+}
+
 export class FileLook {
   readonly mesh: THREE.Mesh;
   private readonly geometry = new THREE.BufferGeometry();
@@ -161,17 +167,17 @@ export class FileLook {
     return !this.appearance || (n !== undefined && n.length === normals.length && n.every((x, i) => x === normals[i]));
   }
 
-  // The selection's colours (3 per mesh vertex): `free` where the file's own colour shows.
-  setColors(colors: Float32Array, free: THREE.Color): void {
+  // The selection's colours (3 bytes per mesh vertex): `free` where the file's own colour shows.
+  setColors(colors: Uint8Array, free: THREE.Color): void {
     const a = this.appearance;
     if (!a) return;
     const l = this.geometry.getAttribute('label') as THREE.BufferAttribute;
     const out = l.array as Uint8Array;
-    const [r, g, b] = [free.r, free.g, free.b].map(Math.fround); // as a Float32Array holds them
+    const [r, g, b] = colorBytes(free);
     for (let i = 0; i < a.vertex.length; ++i) {
       const v = 3 * a.vertex[i];
       const selected = colors[v] !== r || colors[v + 1] !== g || colors[v + 2] !== b;
-      for (let k = 0; k < 3; ++k) out[4 * i + k] = selected ? Math.round(255 * colors[v + k]) : 0;
+      for (let k = 0; k < 3; ++k) out[4 * i + k] = selected ? colors[v + k] : 0;
       out[4 * i + 3] = selected ? 255 : 0;
     }
     l.needsUpdate = true;

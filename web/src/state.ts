@@ -5,6 +5,7 @@ import * as THREE from 'three';
 import { Brush } from './brush';
 import { Connection, ConnectionStatus } from './connection';
 import type { Slot, WorkerReply, WorkerRequest } from './geometry.worker';
+import { colorBytes } from './look';
 import type { Measures } from './measures';
 import * as P from './protocol';
 import { Viewer } from './viewer';
@@ -595,8 +596,8 @@ export class EditorState {
     forwardPart(this.worker, p);
     this.viewer.meshPart(p);
     if (done) await nextTask(); // what follows takes a task of its own
-    const { positions, indices } = this.arrival.mesh!;
-    if (this.arrivalShown && p.kind === 'positions' && done) this.viewer.beginMesh(positions, indices);
+    const { positions, indices, low, high } = this.arrival.mesh!;
+    if (this.arrivalShown && p.kind === 'positions' && done) this.viewer.beginMesh(positions, indices, low, high);
     if (this.arrivalShown && p.kind === 'triangles') this.viewer.addTriangles(p.first, p.data.length / 3);
     if (done === 'mesh') {
       stats.meshReceived = performance.now();
@@ -645,8 +646,10 @@ export class EditorState {
     if (sameTriangles && this.preview) this.postPreview(this.preview); // another pose
     if (sameTriangles) return;
     await nextTask();
-    this.diagonal = diagonalOf(this.rest);
-    this.paint();
+    this.diagonal = Math.hypot(...m.high.map((h, k) => h - m.low[k])) || 1;
+    // A mesh shown as it came is drawn in the free colour, which its labels are (a held
+    // selection painted itself): no pass over its vertices.
+    if (!shown) this.paint();
   }
 
   // The selection held for this mesh in local storage (a reload, another window), if newer than
@@ -831,15 +834,15 @@ export class EditorState {
     let top = this.groups.length + 1;
     if (vertices) for (let i = 0; i < vertices.length; ++i) top = Math.max(top, labels[vertices[i]]);
     else for (let v = 0; v < n; ++v) if (labels[v] > top) top = labels[v];
-    const table = new Float32Array(3 * (top + 2));
+    const table = new Uint8Array(3 * (top + 2));
     for (let l = 0; l <= top; ++l) {
       const kind = this.kindOf(l);
       const c = kind === 'free' ? FREE_COLOR : kind === 'fixed' ? FIXED_COLOR
         : kind === 'pinned' ? PIN_COLOR : GROUP_COLORS[(l - 2) % GROUP_COLORS.length];
-      table.set([c.r, c.g, c.b], 3 * l);
+      table.set(colorBytes(c), 3 * l);
     }
     const heldAt = 3 * (top + 1);
-    table.set([HELD_COLOR.r, HELD_COLOR.g, HELD_COLOR.b], heldAt);
+    table.set(colorBytes(HELD_COLOR), heldAt);
     const changed: number[] = [];
     const count = vertices ? vertices.length : n;
     for (let i = 0; i < count; ++i) {
@@ -864,10 +867,6 @@ const FIXED_COLOR = new THREE.Color(0x4e79a7);
 const HELD_COLOR = new THREE.Color(0x9a9aa3); // held by the region of influence: grey, darker than free
 export const PIN_HEX = 0x1f3b63;
 const PIN_COLOR = new THREE.Color(PIN_HEX);
-
-function diagonalOf(p: Float32Array): number {
-  return new THREE.Box3().setFromArray(p).getSize(new THREE.Vector3()).length() || 1;
-}
 
 export function rowMajor(m: THREE.Matrix4): P.Matrix {
   return m.clone().transpose().toArray();

@@ -11,7 +11,7 @@ import type { BvhReply, BvhRequest } from './bvh.worker';
 import { forwardPart } from './arrival';
 import { GpuArray } from './gpu';
 import { visibleTriangles } from './hide';
-import { FileLook } from './look';
+import { colorBytes, FileLook } from './look';
 import type { AppearanceMessage, MeshPart } from './protocol';
 
 export interface Hit {
@@ -92,7 +92,7 @@ export class Viewer {
     this.gpu = {
       position: new GpuArray(gl, gl.ARRAY_BUFFER, 3, new Float32Array(0)),
       normal: new GpuArray(gl, gl.ARRAY_BUFFER, 3, new Float32Array(0)),
-      color: new GpuArray(gl, gl.ARRAY_BUFFER, 3, new Float32Array(0)),
+      color: new GpuArray(gl, gl.ARRAY_BUFFER, 3, new Uint8Array(0)),
       index: new GpuArray(gl, gl.ELEMENT_ARRAY_BUFFER, 1, new Uint32Array(0)),
     };
     this.surface = new THREE.Mesh(this.drawn, this.flat);
@@ -163,8 +163,9 @@ export class Viewer {
 
   // A new mesh as it arrives: its positions (framed at once), in the free colour, then its
   // triangles a part at a time (addTriangles), drawn flat until setMesh and its normals.
-  // `positions` and `indices` are the arrays the parts fill; read until setMesh.
-  beginMesh(positions: Float32Array, indices: Uint32Array): void {
+  // `positions` and `indices` are the arrays the parts fill; read until setMesh. `low`, `high`: the
+  // positions' bounding box.
+  beginMesh(positions: Float32Array, indices: Uint32Array, low: number[], high: number[]): void {
     const n = positions.length / 3;
     [this.arriving, this.uploaded, this.showFrame] = [true, false, null];
     this.renderer.resetState();
@@ -179,11 +180,17 @@ export class Viewer {
     this.bvh = null;
     this.look.set(null);
     this.shading = 'flat';
-    // The smooth program compiled now, while the mesh comes: its first use waits for it.
-    this.surface.material = this.smooth;
-    this.renderer.compile(this.scene, this.camera);
     this.showSurface();
-    this.arrivingSphere = new THREE.Box3().setFromArray(positions).getBoundingSphere(new THREE.Sphere());
+    // The smooth program compiled while the mesh comes, in a task of its own: its first use
+    // waits for it.
+    setTimeout(() => {
+      const drawn = this.surface.material;
+      this.surface.material = this.smooth;
+      this.renderer.compile(this.scene, this.camera);
+      this.surface.material = drawn;
+    });
+    const box = new THREE.Box3(new THREE.Vector3(...low), new THREE.Vector3(...high));
+    this.arrivingSphere = box.getBoundingSphere(new THREE.Sphere());
     this.frameMesh(this.arrivingSphere);
     this.uploadLater();
   }
@@ -209,9 +216,9 @@ export class Viewer {
     this.geometry.setAttribute('position', new THREE.BufferAttribute(positions, 3));
     // An arrived mesh's colours and normals are the arrays its GPU buffers were filled from.
     const colors = this.geometry.getAttribute('color');
-    if (arrived) this.geometry.setAttribute('color', new THREE.BufferAttribute(this.gpu.color.array, 3));
+    if (arrived) this.geometry.setAttribute('color', new THREE.BufferAttribute(this.gpu.color.array, 3, true));
     else if (!colors || colors.count !== n) {
-      this.geometry.setAttribute('color', new THREE.BufferAttribute(filled(n, this.freeColor), 3));
+      this.geometry.setAttribute('color', new THREE.BufferAttribute(filled(n, this.freeColor), 3, true));
     }
     this.geometry.setAttribute('normal', new THREE.BufferAttribute(arrived ? this.gpu.normal.array : new Float32Array(3 * n), 3));
     if (arrived && this.arrivingSphere) this.geometry.boundingSphere = this.arrivingSphere;
@@ -220,7 +227,7 @@ export class Viewer {
     this.showFrame = null; // a frame of the old mesh on its way is dropped (set)
     this.gpu.position.set(positions, arrived);
     this.gpu.normal.set(this.normals(), true); // not drawn until setPositions uploads them
-    this.gpu.color.set(this.geometry.getAttribute('color').array as Float32Array, arrived);
+    this.gpu.color.set(this.colors, arrived);
     if (!keepCamera) [this.hiddenMask, this.hiddenCount] = [null, 0];
     this.showHidden(arrived);
     this.bindDrawn();
@@ -334,7 +341,7 @@ export class Viewer {
     this.look.set(a);
     this.look.setHidden(this.hiddenMask);
     this.look.setPositions(this.positions(), null);
-    this.look.setColors(this.geometry.getAttribute('color').array as Float32Array, this.freeColor);
+    this.look.setColors(this.colors, this.freeColor);
     this.showSurface();
     this.changedContent();
   }
@@ -408,10 +415,10 @@ export class Viewer {
   }
   private showFrame: (() => void) | null = null; // once the large frame on its way is all there
 
-  // The vertices' colours (3 floats each), which the caller changes in place and then names
-  // (colorsChanged).
-  get colors(): Float32Array {
-    return this.geometry.getAttribute('color').array as Float32Array;
+  // The vertices' colours (3 bytes each: colorBytes), which the caller changes in place and then
+  // names (colorsChanged).
+  get colors(): Uint8Array {
+    return this.geometry.getAttribute('color').array as Uint8Array;
   }
 
   // The vertices listed (ascending) took new colours: only their runs are uploaded, runs
@@ -440,7 +447,7 @@ export class Viewer {
     this.coarseGeometry.setIndex(new THREE.BufferAttribute(visibleTriangles(this.coarseIndices, this.hiddenMask, vertices), 1));
     this.coarseGeometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * k), 3));
     this.coarseGeometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(3 * k), 3));
-    this.coarseGeometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * k), 3));
+    this.coarseGeometry.setAttribute('color', new THREE.BufferAttribute(new Uint8Array(3 * k), 3, true));
     this.syncCoarseColors();
   }
 
@@ -479,8 +486,8 @@ export class Viewer {
   private syncCoarseColors(): void {
     const target = this.coarseGeometry.getAttribute('color') as THREE.BufferAttribute | undefined;
     if (!target) return;
-    const source = this.geometry.getAttribute('color').array as Float32Array;
-    const out = target.array as Float32Array;
+    const source = this.colors;
+    const out = target.array as Uint8Array;
     this.coarseVertices.forEach((v, i) => {
       out[3 * i] = source[3 * v];
       out[3 * i + 1] = source[3 * v + 1];
@@ -852,10 +859,10 @@ export class Viewer {
 }
 
 // n colours, all `color`: a new mesh's, before it is painted.
-function filled(n: number, color: THREE.Color): Float32Array<ArrayBuffer> {
-  const colors = new Float32Array(3 * n);
+function filled(n: number, color: THREE.Color): Uint8Array<ArrayBuffer> {
+  const colors = new Uint8Array(3 * n);
   if (n === 0) return colors;
-  colors.set([color.r, color.g, color.b]);
+  colors.set(colorBytes(color));
   for (let done = 3; done < colors.length; done *= 2) colors.copyWithin(done, 0, Math.min(done, colors.length - done));
   return colors;
 }
