@@ -85,6 +85,7 @@ try {
     window.statusLog = [];
     addEventListener('pointerup', () => (window.releasedAt = performance.now()), true);
     window.longTasks = []; // [start, duration] (ms) of tasks that held the page over 50 ms
+    window.harnessTasks = []; // [start, end] (ms) of the harness's own work in the page
     new PerformanceObserver((l) => window.longTasks.push(...l.getEntries().map((e) => [e.startTime, e.duration])))
       .observe({ entryTypes: ['longtask'] });
     document.addEventListener('DOMContentLoaded', () => {
@@ -123,10 +124,14 @@ try {
   const arrival = await api(() => window.specdeformEditor.stats);
   result.mesh_first_byte_s = arrival.meshStarted / 1000;
   result.mesh_received_s = arrival.meshReceived / 1000;
+  result.mesh_seen_s = arrival.meshSeen / 1000; // some of its triangles drawn
   result.mesh_shown_s = arrival.meshShown / 1000;
   result.mesh_drawn_s = drawn.at / 1000;
   log(`mesh drawn at ${result.mesh_drawn_s.toFixed(2)} s, phase ${drawn.phase}`);
+  // (The harness's own work in the page, here and below, is marked: its tasks are not the
+  // editor's.)
   const shades = await api(() => {
+    const t0 = performance.now();
     const gl = document.querySelector('#view canvas');
     const c = Object.assign(document.createElement('canvas'), { width: gl.width, height: gl.height });
     const ctx = c.getContext('2d');
@@ -134,12 +139,14 @@ try {
     const d = ctx.getImageData(0, 0, c.width, c.height).data;
     const set = new Set();
     for (let i = 0; i < d.length; i += 4) set.add(d[i] >> 3);
+    window.harnessTasks.push([t0, performance.now()]);
     return set.size;
   });
   check(shades > 8, `the mesh is drawn shaded (${shades} shades)`);
 
   // The two ends of the model along its longest axis, among the vertices facing the camera.
   const ends = await api(() => {
+    const t0 = performance.now();
     const e = window.specdeformEditor;
     const p = e.restPositions();
     const n = p.length / 3;
@@ -159,7 +166,9 @@ try {
       }
       return best;
     };
-    return { handle: pick(1), fixed: pick(-1), n };
+    const found = { handle: pick(1), fixed: pick(-1), n };
+    window.harnessTasks.push([t0, performance.now()]);
+    return found;
   });
   check(ends.handle >= 0 && ends.fixed >= 0, `both ends are visible (${JSON.stringify(ends)})`);
   result.vertices = ends.n;
@@ -261,13 +270,16 @@ try {
   result.drag_detailed_after_release_s = (Date.now() - up) / 1000;
   result.first_drag_drawn_s = (await now()) / 1000;
   // Where the page's main thread was held (tasks over 50 ms), up to the drag's detail.
-  const longTasks = await api(() => window.longTasks);
+  const { longTasks, harnessTasks } = await api(() => ({ longTasks: window.longTasks, harnessTasks: window.harnessTasks }));
+  const harness = ([t, d]) => harnessTasks.some(([b, e]) => b >= t && e <= t + d);
+  result.harness_tasks_s = longTasks.filter(harness).map(([t, d]) => [+(t / 1000).toFixed(2), +(d / 1000).toFixed(2)]);
   result.long_tasks_s = longTasks.sort((a, b) => b[1] - a[1]).slice(0, 8)
     .map(([t, d]) => [+(t / 1000).toFixed(2), +(d / 1000).toFixed(2)]);
   // From the mesh's first part to the first drag (its press), a task that took the first part
   // included: the page answers throughout.
   result.longest_task_to_drag_s = +(Math.max(0, ...longTasks
-    .filter(([t, d]) => t + d > arrival.meshStarted && t < result.drag_started_s * 1000).map(([, d]) => d)) / 1000).toFixed(3);
+    .filter(([t, d]) => t + d > arrival.meshStarted && t < result.drag_started_s * 1000 && !harness([t, d]))
+    .map(([, d]) => d)) / 1000).toFixed(3);
   check(result.longest_task_to_drag_s < kLongestTaskS,
     `no task holds the page ${kLongestTaskS} s from the mesh's first part to the first drag (${result.longest_task_to_drag_s} s)`);
   result.messages_s = messages.filter(([t]) => t <= result.first_drag_drawn_s + 0.5);

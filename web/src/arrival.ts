@@ -1,7 +1,8 @@
 // A mesh arriving in parts (protocol.ts, 101): its positions, then its triangles, gathered into
-// arrays of the whole, with the bytes come so far for the page's counter. The page's state and
-// both workers gather the parts each (a copy of the whole held the page).
-import type { MeshPart } from './protocol';
+// arrays of the whole, with the bytes come so far for the page's counter. The geometry worker reads
+// the mesh (readMesh) and hands each part on to the page and to the picking BVH's worker, which
+// gather them each (the page's thread was held reading the mesh and copying it for the workers).
+import { decodeMeshPart, type MeshPart } from './protocol';
 
 export interface WholeMesh {
   positions: Float32Array<ArrayBuffer>; // 3 n
@@ -67,8 +68,35 @@ function bound(m: WholeMesh, positions: Float32Array): void {
   }
 }
 
-// Sends a copy of a part to a worker (the part's arrays view the whole response).
-export function forwardPart(worker: Worker, part: MeshPart): void {
+// Reads the mesh body at `url` (the server's parts one after another), handing each part to
+// `onPart` as it completes, while `current()` holds (a newer reading takes over); returns the
+// mesh's id (X-Mesh-Id), or null where the server has none there (404).
+export async function readMesh(url: string, onPart: (p: MeshPart) => void, current: () => boolean): Promise<string | null> {
+  const response = await fetch(url);
+  if (response.status === 404) return null;
+  if (!response.ok || !response.body) throw new Error(`${response.status} ${response.statusText}`);
+  const reader = response.body.getReader();
+  const bytes = new Uint8Array(Number(response.headers.get('Content-Length')));
+  let [end, at] = [0, 0];
+  for (;;) {
+    const { done, value } = await reader.read();
+    if (!current()) {
+      await reader.cancel();
+      break;
+    }
+    if (done) break;
+    if (end + value.length > bytes.length) throw new Error('more bytes than announced');
+    bytes.set(value, end);
+    end += value.length;
+    for (let next; (next = decodeMeshPart(bytes.buffer, at, end)); at += next[1]) onPart(next[0]);
+  }
+  if (current() && at !== bytes.length) throw new Error(`${at} of ${bytes.length} bytes`);
+  return response.headers.get('X-Mesh-Id');
+}
+
+// A copy of a part for another thread, and what to transfer (the part's arrays view the whole
+// body).
+export function partCopy(part: MeshPart): [MeshPart, Transferable[]] {
   const data = part.data.slice();
-  worker.postMessage({ kind: 'part', part: { ...part, data } }, [data.buffer]);
+  return [{ ...part, data }, [data.buffer]];
 }

@@ -1,8 +1,10 @@
-// Off the main thread: the positions of every frame from its 16-bit displacements, their
-// vertex normals (of the full mesh and of the coarse preview), the full frames' area, volume
-// and stretch against the input (measures.ts), and the brush (the vertices within a radius, along the surface or in space), so that
-// the page keeps taking pointer events while a large mesh is processed.
-import { MeshArrival } from './arrival';
+// Off the main thread: the mesh's body read as it comes, a part at a time handed on to the page
+// and to the picking BVH's worker (a port of its own); the positions of every frame from its
+// 16-bit displacements, their vertex normals (of the full mesh and of the coarse preview), the
+// full frames' area, volume and stretch against the input (measures.ts), and the brush (the
+// vertices within a radius, along the surface or in space), so that the page keeps taking
+// pointer events while a large mesh is processed.
+import { MeshArrival, partCopy, readMesh } from './arrival';
 import { Brush } from './brush';
 import { groupNormals } from './look';
 import { Measures, MeshMeasures } from './measures';
@@ -12,9 +14,10 @@ import type { MeshPart } from './protocol';
 export type Slot = 'full' | 'preview';
 
 export type WorkerRequest =
-  // The full mesh comes a part at a time, as the page receives it; `adopt` makes the last one
-  // that came whole the full slot's.
-  | { kind: 'part'; part: MeshPart }
+  // The mesh at `url` read (a newer `fetch` drops an older one), its parts handed on as they come
+  // (`part` replies, then `fetched`); `adopt` makes the last one that came whole the full slot's.
+  | { kind: 'fetch'; fetch: number; url: string }
+  | { kind: 'bvh'; port: MessagePort } // where the parts go besides the page
   | { kind: 'adopt' }
   | { kind: 'preview'; indices: Uint32Array; rest: Float32Array } // the coarse mesh of drags
   // The full mesh's file look: render vertices (their mesh vertex and normal group) and triangles.
@@ -23,6 +26,9 @@ export type WorkerRequest =
   | { kind: 'brush'; id: number; vertex: number; center: [number, number, number]; radius: number; geodesic: boolean };
 
 export type WorkerReply =
+  | { kind: 'part'; fetch: number; part: MeshPart }
+  // The mesh's id, null where the server has none there; `error`: why it did not come.
+  | { kind: 'fetched'; fetch: number; id: string | null; error: string | null }
   | { kind: 'frame'; slot: Slot; seq: number; positions: Float32Array; normals: Float32Array;
       lookNormals: Float32Array | null }
   | { kind: 'measures'; seq: number; measures: Measures | null } // of the full frame `seq`
@@ -47,14 +53,27 @@ interface Look {
 
 const meshes: Partial<Record<Slot, Mesh>> = {};
 const arrival = new MeshArrival();
+let fetching = 0; // the last fetch asked for
+let bvhPort: MessagePort | null = null;
 let look: Look | null = null;
 const post = (reply: WorkerReply, transfer: Transferable[]) =>
   (self as unknown as Worker).postMessage(reply, transfer);
 
 self.onmessage = (e: MessageEvent<WorkerRequest>) => {
   const m = e.data;
-  if (m.kind === 'part') {
-    arrival.add(m.part);
+  if (m.kind === 'fetch') {
+    fetching = m.fetch;
+    const handOn = (part: MeshPart) => {
+      arrival.add(part);
+      bvhPort?.postMessage(...partCopy(part));
+      const [copy, transfer] = partCopy(part);
+      post({ kind: 'part', fetch: m.fetch, part: copy }, transfer);
+    };
+    readMesh(m.url, handOn, () => fetching === m.fetch).then(
+      (id) => post({ kind: 'fetched', fetch: m.fetch, id, error: null }, []),
+      (e: unknown) => post({ kind: 'fetched', fetch: m.fetch, id: null, error: e instanceof Error ? e.message : String(e) }, []));
+  } else if (m.kind === 'bvh') {
+    bvhPort = m.port;
   } else if (m.kind === 'adopt') {
     if (!arrival.whole) return;
     const { indices, positions } = arrival.mesh!;

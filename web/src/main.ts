@@ -7,15 +7,16 @@ import { Connection } from './connection';
 import { Interaction } from './interaction';
 import { Panel } from './panel';
 import * as P from './protocol';
-import { EditorState, rowMajor, stats } from './state';
+import { EditorState, rowMajor, startWorker, stats } from './state';
 import { Viewer } from './viewer';
 
-// The socket first: the server sends the mesh while the page makes its view (a second without
-// a GPU).
+// The mesh's reading and the socket first: they come while the page makes its view (a second
+// without a GPU).
+const worker = startWorker();
 const connection = new Connection(`ws://${location.host}/ws`);
 connection.connect();
 const view = document.getElementById('view')!;
-const state = new EditorState(new Viewer(view), connection);
+const state = new EditorState(new Viewer(view), connection, worker);
 const interaction = new Interaction(state, view);
 new Panel(state, interaction);
 interaction.setTool('handle');

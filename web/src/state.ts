@@ -9,7 +9,7 @@ import { colorBytes } from './look';
 import type { Measures } from './measures';
 import * as P from './protocol';
 import { Viewer } from './viewer';
-import { forwardPart, MeshArrival, type WholeMesh } from './arrival';
+import { MeshArrival, type WholeMesh } from './arrival';
 import { dropHeld, loadHeld, meshKey, saveHeld } from './held';
 
 // Per-vertex labels: 0 free, 1 fixed, 2 + g handle group g.
@@ -43,6 +43,7 @@ export const stats = {
   drawTimes: [] as number[],
   meshStarted: null as number | null, // performance.now() when the last mesh's first part came
   meshReceived: null as number | null, // its last part
+  meshSeen: null as number | null, // when some of its triangles were first drawn
   meshShown: null as number | null, // when the last new mesh was first drawn whole
   meshDrawn: null as number | null, // and shaded with its normals
   detailedDrawn: null as number | null, // and when the last frame of the whole mesh was drawn
@@ -101,8 +102,8 @@ export class EditorState {
   private outstanding: number | null = null; // the last frame sent, until a result as new arrives
   private lastDrawn = 0;
   private readonly arrival = new MeshArrival(); // the mesh's parts as they come
+  private readonly worker: Worker; // the geometry worker (geometry.worker.ts)
   private arrivalShown = false; // drawn as it comes (a new mesh; the same one again when whole)
-  private worker = new Worker(new URL('./geometry.worker.ts', import.meta.url), { type: 'module' });
   private normalsBusy: Record<Slot, boolean> = { full: false, preview: false };
   private normalsQueued: Record<Slot, P.FrameResult | null> = { full: null, preview: null };
   private brushId = 0;
@@ -116,8 +117,11 @@ export class EditorState {
   private selectionWaiting = false; // a selection made since: sent when they are answered
   private restorePending = false; // a restored selection is on its way back
 
-  // `connection`: to the server, maybe opened already.
-  constructor(readonly viewer: Viewer, readonly connection: Connection) {
+  // `connection`: to the server, maybe opened already; `started`: the geometry worker, reading the
+  // open mesh since the page's start.
+  constructor(readonly viewer: Viewer, readonly connection: Connection, started: StartedWorker) {
+    this.worker = started.worker;
+    viewer.takeMeshParts(started.bvhParts);
     viewer.freeColor = FREE_COLOR;
     connection.on = {
       status: (s) => this.onStatus(s),
@@ -125,7 +129,7 @@ export class EditorState {
       binary: (b) => this.receive(() => this.onBinary(b), false),
     };
     this.worker.onmessage = (e: MessageEvent<WorkerReply>) => this.onWorker(e.data);
-    void this.fetchMesh(null);
+    void this.takeMesh(1, null);
     viewer.onRendered = () => this.onRendered();
     viewer.onDrawTimed = (ms, draw) => this.drawTimed(ms, draw);
   }
@@ -457,6 +461,11 @@ export class EditorState {
   }
 
   private onWorker(m: WorkerReply): void {
+    if (m.kind === 'part' || m.kind === 'fetched') {
+      if (m.fetch !== this.meshFetches) return;
+      this.meshReplies.push(m);
+      return this.meshReplied?.();
+    }
     if (m.kind === 'brush') {
       this.brushReplies.get(m.id)?.(m.vertices);
       this.brushReplies.delete(m.id);
@@ -500,6 +509,9 @@ export class EditorState {
   }
 
   private onRendered(): void {
+    if (stats.meshSeen === null && stats.meshStarted !== null && this.viewer.trianglesShown > 0) {
+      stats.meshSeen = performance.now();
+    }
     if (!this.wholeShown && this.viewer.whole) {
       this.wholeShown = true;
       stats.meshShown = performance.now();
@@ -536,42 +548,39 @@ export class EditorState {
     return a.mesh && !a.whole ? { bytes: a.bytes, total: a.totalBytes } : null;
   }
 
-  // Fetches a mesh and takes its parts as they come, a task at a time (a newer fetch drops it);
-  // the socket's other messages wait meanwhile. Without a notice: the latest mesh, fetched as
-  // the page starts, so that its bytes come while the page makes its view (seconds without a
-  // GPU); a notice of the mesh fetched, or on its way, fetches nothing.
-  private async fetchMesh(m: P.MeshNotice | null): Promise<void> {
-    if (m && (await this.meshId) === m.id) return;
+  // Fetches the mesh of a notice, unless it is the one fetched or on its way.
+  private async fetchMesh(m: P.MeshNotice): Promise<void> {
+    if ((await this.meshId) === m.id) return;
     const fetching = ++this.meshFetches;
+    this.post({ kind: 'fetch', fetch: fetching, url: `/mesh/${m.id}` });
+    return this.takeMesh(fetching, m);
+  }
+
+  // Takes the parts of a fetch (by number) as the worker reads them (the page's thread was held
+  // reading them) and hands them on, a task at a time; a newer fetch drops it. The socket's other
+  // messages wait meanwhile. Without a notice: the fetch of the latest mesh, from the page's start.
+  private async takeMesh(fetching: number, m: P.MeshNotice | null): Promise<void> {
     this.waiting ??= [];
     let named = (_: string | null) => {};
     this.meshId = new Promise((resolve) => (named = resolve));
+    this.meshReplies = [];
+    this.meshReplied?.(); // an older fetch's wait ends
     try {
-      const response = await fetch(m ? `/mesh/${m.id}` : '/mesh/latest');
-      named(response.ok ? response.headers.get('X-Mesh-Id') : null);
-      if (m || response.status !== 404) { // without a notice, none may be open yet
-        if (!response.ok || !response.body) throw new Error(`${response.status} ${response.statusText}`);
-        const reader = response.body.getReader();
-        const bytes = new Uint8Array(Number(response.headers.get('Content-Length')));
-        let [end, at, task] = [0, 0, performance.now()];
-        for (;;) {
-          const { done, value } = await reader.read();
-          if (fetching !== this.meshFetches) return void reader.cancel();
-          if (done) break;
-          if (end + value.length > bytes.length) throw new Error('more bytes than announced');
-          bytes.set(value, end);
-          end += value.length;
-          for (let next; (next = P.decodeMeshPart(bytes.buffer, at, end)); at += next[1]) {
-            await this.meshPart(next[0]);
-            if (performance.now() - task > kTaskMs) {
-              await nextTask();
-              if (fetching !== this.meshFetches) return void reader.cancel();
-              task = performance.now();
-            }
-          }
+      let task = performance.now();
+      for (let reply; (reply = await this.nextMeshReply(fetching));) {
+        if (reply.kind === 'fetched') {
+          named(reply.id);
+          if (reply.error) throw new Error(reply.error);
+          if (m && reply.id === null) throw new Error('the server has it no more'); // without a notice, none may be open yet
+          break;
         }
-        if (at !== bytes.length) throw new Error(`${at} of ${bytes.length} bytes`);
+        await this.meshPart(reply.part);
+        if (performance.now() - task > kTaskMs) {
+          await nextTask();
+          task = performance.now();
+        }
       }
+      if (fetching !== this.meshFetches) return;
     } catch (e) {
       named(null);
       if (fetching !== this.meshFetches) return;
@@ -584,17 +593,25 @@ export class EditorState {
     this.changed();
   }
   private meshId: Promise<string | null> | null = null; // of the last fetch, once it answered
-  private meshFetches = 0;
+  private meshFetches = 1; // asked of the worker, the first by startWorker
+  private meshReplies: MeshReply[] = []; // of the last fetch, not taken yet
+  private meshReplied: (() => void) | undefined; // wakes the fetch waiting for them
+
+  // The last fetch's next reply from the worker, once it came; null once a newer fetch began.
+  private async nextMeshReply(fetching: number): Promise<MeshReply | null> {
+    while (this.meshReplies.length === 0 && fetching === this.meshFetches) {
+      await new Promise<void>((resolve) => (this.meshReplied = resolve));
+    }
+    return fetching === this.meshFetches ? this.meshReplies.shift()! : null;
+  }
 
   // Takes a part; the last one's mesh is taken in a few tasks (the promise).
   private async meshPart(p: P.MeshPart): Promise<void> {
     if (p.kind === 'positions' && p.first === 0) {
-      stats.meshStarted = performance.now();
+      [stats.meshStarted, stats.meshSeen] = [performance.now(), null];
       this.arrivalShown = 3 * p.n !== this.rest.length || 3 * p.triangles !== this.indices.length;
     }
     const done = this.arrival.add(p);
-    forwardPart(this.worker, p);
-    this.viewer.meshPart(p);
     if (done) await nextTask(); // what follows takes a task of its own
     const { positions, indices, low, high } = this.arrival.mesh!;
     if (this.arrivalShown && p.kind === 'positions' && done) this.viewer.beginMesh(positions, indices, low, high);
@@ -879,6 +896,24 @@ export function fromRowMajor(a: P.Matrix): THREE.Matrix4 {
 // Requests answered with "state" (or "empty"), or with an error naming them.
 const STATE_REQUESTS = new Set(['selection', 'commit', 'hello', 'undo', 'redo', 'apply_pose', 'open_demo',
   'mesh_file', 'selection_file', 'scene_file']);
+
+type MeshReply = Extract<WorkerReply, { kind: 'part' | 'fetched' }>;
+
+// The geometry worker, reading the latest mesh at once (fetch 1): its bytes come while the page
+// makes its view (seconds without a GPU). The parts it reads go to the page and to `bvhParts`
+// (held there until the picking BVH's worker takes them).
+export interface StartedWorker {
+  worker: Worker;
+  bvhParts: MessagePort;
+}
+
+export function startWorker(): StartedWorker {
+  const worker = new Worker(new URL('./geometry.worker.ts', import.meta.url), { type: 'module' });
+  const channel = new MessageChannel();
+  worker.postMessage({ kind: 'bvh', port: channel.port1 } satisfies WorkerRequest, [channel.port1]);
+  worker.postMessage({ kind: 'fetch', fetch: 1, url: '/mesh/latest' } satisfies WorkerRequest);
+  return { worker, bvhParts: channel.port2 };
+}
 
 function requestName(request: string): string {
   const names: Record<string, string> = {

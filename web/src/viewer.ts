@@ -8,11 +8,10 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TransformControls } from 'three/addons/controls/TransformControls.js';
 import { MeshBVH } from 'three-mesh-bvh';
 import type { BvhReply, BvhRequest } from './bvh.worker';
-import { forwardPart } from './arrival';
 import { GpuArray } from './gpu';
 import { visibleTriangles } from './hide';
 import { colorBytes, FileLook } from './look';
-import type { AppearanceMessage, MeshPart } from './protocol';
+import type { AppearanceMessage } from './protocol';
 
 export interface Hit {
   point: THREE.Vector3;
@@ -173,6 +172,7 @@ export class Viewer {
     this.gpu.normal.fresh(new Float32Array(3 * n)); // not drawn until setPositions
     this.gpu.color.set(filled(n, this.freeColor));
     this.gpu.index.fresh(indices);
+    [this.trianglesUp, this.trianglesShown] = [0, 0];
     this.drawn.setDrawRange(0, 0);
     this.bindDrawn();
     [this.hiddenMask, this.hiddenCount] = [null, 0];
@@ -195,15 +195,14 @@ export class Viewer {
     this.uploadLater();
   }
 
-  // Every part of every mesh, for the picking BVH's worker (setMesh builds it).
-  meshPart(part: MeshPart): void {
-    forwardPart(this.bvhWorker, part);
+  // The picking BVH's worker takes every part of every mesh from `port` (setMesh builds it).
+  takeMeshParts(port: MessagePort): void {
+    this.bvhWorker.postMessage({ kind: 'parts', port } satisfies BvhRequest, [port]);
   }
 
   // Triangles [first, first + count) of the arriving mesh came.
   addTriangles(first: number, count: number): void {
     this.gpu.index.update(3 * first, 3 * count);
-    this.drawn.setDrawRange(0, 3 * (first + count));
     this.uploadLater();
   }
 
@@ -272,7 +271,11 @@ export class Viewer {
     setTimeout(() => {
       this.uploadQueued = false;
       if (this.drawing()) return this.uploadLater(); // an upload would wait behind the draw
-      this.upload(this.arriving ? kUploadBytes : Infinity, kUploadBytes);
+      // 1 MB at a time, for as long as kUploadMs allows (a software renderer busy elsewhere
+      // takes tens of milliseconds a megabyte, an idle one a few).
+      const start = performance.now();
+      do this.upload(this.arriving ? kUploadBytes : Infinity, kUploadBytes);
+      while (performance.now() - start < kUploadMs && Object.values(this.gpu).some((a) => a.pendingBytes > 0 || (a.framePending && !a.frameReady)));
       // A frame is drawn once both of its arrays are there.
       const ready = (a: GpuArray) => !a.framePending || a.frameReady;
       const swap = (position.framePending || normal.framePending) && ready(position) && ready(normal);
@@ -289,9 +292,14 @@ export class Viewer {
         this.arriving = false;
         this.showSurface();
       }
-      // Drawn now and then as it comes (each draw of it costs a software renderer as much as the
-      // whole mesh's), a frame once it is there.
-      if (swap || (this.arriving ? performance.now() - this.lastDraw > kArrivalDrawMs : !left)) this.changedContent();
+      // Drawn now and then as more of its triangles are up while its parts come (each draw costs
+      // a software renderer as much as the whole mesh's, and holds the uploads), then once all of
+      // it is up (flat, unless its normals are on their way: it is drawn with them), a frame once
+      // it is there.
+      const more = this.geometry.index === null
+        ? this.trianglesUp > this.trianglesShown && performance.now() - this.lastDraw > kArrivalDrawMs
+        : this.uploaded && !position.framePending && !normal.framePending && this.trianglesShown < this.drawnTriangles;
+      if (swap || (this.arriving ? more : !left)) this.changedContent();
       if (left) this.uploadLater();
     });
   }
@@ -313,7 +321,14 @@ export class Viewer {
     const arrays = Object.values(this.gpu).filter((a) => a.pendingBytes > 0 || (frames > 0 && a.framePending));
     if (arrays.length === 0) return;
     this.renderer.resetState(); // three.js's GL state: bound vertex arrays and buffers
-    for (const a of arrays) budget -= a.flush(budget);
+    for (const a of arrays) {
+      const bytes = a.flush(budget);
+      budget -= bytes;
+      if (a === this.gpu.index) this.trianglesUp += bytes / 12;
+    }
+    // The arriving mesh's triangles are drawn as they are up (in order, after all positions
+    // and colours), not those still zeros: a software renderer shades them all the same.
+    if (this.arriving && this.geometry.index === null) this.drawn.setDrawRange(0, 3 * this.trianglesUp);
     for (const a of arrays) frames -= a.flushFrame(frames);
   }
 
@@ -738,6 +753,8 @@ export class Viewer {
         gl.flush();
       }
       this.lastDraw = performance.now();
+      const drawnRange = Math.min(this.drawn.drawRange.count, this.drawn.index?.count ?? 0) / 3;
+      this.trianglesShown = this.arriving && !this.uploaded ? Math.min(this.trianglesUp, drawnRange) : drawnRange;
       ++this.draws;
       // The full mesh's draws, timed one at a time, pace the next (a draw without it is quick).
       const full = this.surface.visible || this.look.mesh.visible;
@@ -767,6 +784,8 @@ export class Viewer {
   drawsSkipped = 0; // asked for, but they would have shown what was shown
   private drawAgain = false;
   private lastDraw = -Infinity;
+  private trianglesUp = 0; // of an arriving mesh, uploaded so far
+  trianglesShown = 0; // by the last draw: of an arriving mesh, those uploaded, in order
 
   // The axis widget: the world axes as the camera sees them, +X red, +Y green, +Z blue.
   private axisEnds(): { axis: THREE.Vector3; x: number; y: number; depth: number; label: string; color: string }[] {
@@ -875,12 +894,14 @@ function equal(a: Float32Array, b: Float32Array): boolean {
 
 // Draws slower than this are spaced out (requestRender).
 const kSlowDrawMs = 50;
-// Uploaded a task while a mesh arrives: 1 MB, tens of milliseconds of the page's thread on a
-// software renderer with the server's basis computing beside it.
+// Uploaded at a time while a mesh arrives (1 MB: tens of milliseconds of the page's thread on a
+// software renderer with the server's basis computing beside it), again while a task has been
+// at it for less than kUploadMs.
 const kUploadBytes = 1 << 20;
-const kArrivalDrawMs = 500;
+const kUploadMs = 20;
+const kArrivalDrawMs = 500; // a mesh coming is drawn this often at most
 const kColorGap = 64; // vertices between two painted runs uploaded as one
-const kColorRuns = 1024; // runs uploaded one by one at most // a mesh coming is drawn this often at most
+const kColorRuns = 1024; // runs uploaded one by one at most
 
 // The renderer, without multisampling where the context is a software renderer (no GPU: it
 // would spend most of a frame on it), with it otherwise. One context is made there (a second
