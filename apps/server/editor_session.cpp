@@ -722,6 +722,11 @@ void EditorSession::build(LoadedMesh mesh, std::string name, int modes,
   s.diagonal = bounding_box_diagonal(s.rest());
   s.history.push_back({s.edit, 0});
   state_ = std::move(next);
+  {
+    std::lock_guard lock(saved_mutex_);
+    ++opened_;
+    saved_.clear();
+  }
   watch_detail();
   send_ready();
   send_selection();
@@ -733,6 +738,7 @@ void EditorSession::resend_edit(bool mesh) {
   if (!state_) return;
   if (mesh) send_mesh();
   send_ready();
+  if (std::lock_guard lock(saved_mutex_); !saved_.empty()) send_(false, saved_);
   send_selection();
   if (state_->has_handles) solve_and_send();
 }
@@ -744,15 +750,22 @@ void EditorSession::save_in_background() {
   const std::filesystem::path file = std::exchange(b.save_to, {});
   send_(false, dump({{"type", "saving"}, {"file", file.filename().string()}, {"done", false}}));
   if (saving_.valid()) saving_.wait();  // one file at a time
-  saving_ =
-      std::async(std::launch::async, [this, file, basis = b.harmonics, mesh = s.rest_mesh(s.pose)] {
-        // A low CPU priority (this thread's own on Linux): it takes a tenth of a core from a drag
-        // at most. At the lowest (19) a thread gets about 1.5% of one beside busy programs (the
-        // transfer's did: detail_reconstruction.cpp), and twice in 14 runs of the loading e2e test
-        // a 35 MB save had not reported after two minutes.
-        lower_this_thread(10);
-        send_(false, dump(save_and_report(file, *basis, mesh)));
-      });
+  const int opened = opened_;           // written on this thread only
+  saving_ = std::async(std::launch::async,
+                       [this, file, opened, basis = b.harmonics, mesh = s.rest_mesh(s.pose)] {
+                         // A low CPU priority (this thread's own on Linux): it takes a tenth of a
+                         // core from a drag at most. At the lowest (19) a thread gets about 1.5% of
+                         // one beside busy programs (the transfer's did:
+                         // detail_reconstruction.cpp), and twice in 14 runs of the loading e2e test
+                         // a 35 MB save had not reported after two minutes.
+                         lower_this_thread(10);
+                         std::string report = dump(save_and_report(file, *basis, mesh));
+                         {
+                           std::lock_guard lock(saved_mutex_);
+                           if (opened == opened_) saved_ = report;
+                         }
+                         send_(false, std::move(report));
+                       });
 }
 
 void EditorSession::send_mesh() {

@@ -34,7 +34,8 @@
 //     {"type": "saving", "file", "done": false}, then {"type": "saving", "file", "done": true,
 //      "seconds", "bytes" (when saved), "error" ("" when saved)}
 //                                    a computed basis written to the cache in the background,
-//                                    after "ready"
+//                                    after "ready" (the last report again after the "ready" a
+//                                    hello brings)
 //     {"type": "ready", "name", "vertices", "faces", "diagonal", "mesh_id", "modes", "settings",
 //      "pose", "basis": {"seconds", "source": "computed|cache|reused", "residual", "warning"},
 //      "setup": {...}, "arap_clusters"}         after a mesh message or a settings request
@@ -59,6 +60,7 @@
 #include <future>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -185,6 +187,12 @@ class EditorSession {
   std::string last_error_;  // of the last request that failed
   std::unique_ptr<State> state_;
   std::future<void> saving_;  // the basis being cached; last: waited for before the rest goes
+  // The last "saving" report (done) of the open mesh's basis, said again to a page that comes
+  // after it (a 43k basis is saved before a page has started); `opened_` counts the meshes
+  // opened, so that a report of the one before is not kept.
+  std::mutex saved_mutex_;
+  std::string saved_;
+  int opened_ = 0;
 };
 
 }  // namespace specdeform::server

@@ -683,7 +683,8 @@ TEST(EditorSessionOpen, ACancelledOpenSendsTheOpenMeshBack) {
 }
 
 // A computed basis is saved to the cache after "ready", in the background, and the page is told
-// when it starts and when it is done; the next open loads it.
+// when it starts and when it is done (a page that comes later, after its "ready"); the next open
+// loads it.
 TEST(EditorSessionOpen, SavesTheBasisInTheBackground) {
   const std::filesystem::path cache =
       std::filesystem::temp_directory_path() / ("specdeform-save-" + std::to_string(::getpid()));
@@ -720,6 +721,22 @@ TEST(EditorSessionOpen, SavesTheBasisInTheBackground) {
     EXPECT_GT(texts.back()["bytes"], 0);
     texts.clear();
   }
+  const auto saving_after_ready = [&] {
+    std::lock_guard lock(mutex);
+    const auto ready = std::find_if(texts.begin(), texts.end(),
+                                    [](const Json& j) { return j["type"] == "ready"; });
+    const auto saving =
+        std::find_if(ready, texts.end(), [](const Json& j) { return j["type"] == "saving"; });
+    const bool said = ready != texts.end() && saving != texts.end() && (*saving)["done"] &&
+                      (*saving)["error"] == "";
+    texts.clear();
+    return said;
+  };
+  session.handle(false, R"({"type": "hello", "has_mesh": false})");
+  EXPECT_TRUE(saving_after_ready());
+  open();
+  session.handle(false, R"({"type": "hello", "has_mesh": true})");
+  EXPECT_FALSE(saving_after_ready());  // loaded: nothing saved, the last mesh's report gone
   open();
   std::lock_guard lock(mutex);
   const auto ready =

@@ -440,8 +440,14 @@ try {
     check(painted.phase === 'loading', `the stroke was painted while the basis computed (${painted.phase})`);
     // A second window takes the session over; then the first, reloaded, takes it back.
     const [second] = await Promise.all([page.waitForEvent('popup'), page.evaluate((u) => window.open(u), page.url())]);
+    // The stroke comes back from the page's own record while the basis computes, from the server
+    // once it is ready (the window before sent it and dropped the record).
     const keeps = async (p, name) => {
       await p.waitForFunction((n) => window.specdeformEditor?.vertices() === n, painted.labels.length, { timeout: 60000 });
+      await p.waitForFunction((want) => {
+        const labels = window.specdeformEditor.labels();
+        return labels.length === want.length && labels.every((l, i) => l === want[i]);
+      }, painted.labels, { timeout: 30000, polling: 200 }).catch(() => {});
       const back = await p.evaluate(() => window.specdeformEditor.labels());
       const tally = (labels) => JSON.stringify(labels.reduce((t, l) => ({ ...t, [l]: (t[l] ?? 0) + 1 }), {}));
       check(JSON.stringify(back) === JSON.stringify(painted.labels),

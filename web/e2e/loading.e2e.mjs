@@ -40,7 +40,7 @@ const kPollMs = 50;
 // The longest a loading label may stand still (s): once a second, and a long task of the page.
 const kStillLabelS = 2.5;
 // The longest the page's thread may be held from the mesh's first part to the first drag (s):
-// 0.14-0.23 s at 692k on two shared cores; the mesh's adoption in one task took 1.8-2 s.
+// 0.06-0.14 s at 692k on two shared cores; the mesh's adoption in one task took 1.8-2 s.
 const kLongestTaskS = 0.5;
 
 // CPU seconds used so far by the server, by Chromium's processes and by this script (Linux's

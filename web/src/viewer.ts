@@ -95,6 +95,12 @@ export class Viewer {
       index: new GpuArray(gl, gl.ELEMENT_ARRAY_BUFFER, 1, new Uint32Array(0)),
     };
     this.surface = new THREE.Mesh(this.drawn, this.flat);
+    // Both of its programs made at the page's start: three.js took 0.1 s of the page's thread to
+    // build one as a mesh came, and the software renderer's linking held the uploads after it.
+    for (const material of [this.smooth, this.flat]) {
+      this.surface.material = material;
+      this.renderer.compile(this.surface, this.camera, this.scene);
+    }
     this.coarse = new THREE.Mesh(this.coarseGeometry, this.smooth);
     this.coarse.visible = false;
     this.wireframe = new THREE.Mesh(
@@ -181,14 +187,6 @@ export class Viewer {
     this.look.set(null);
     this.shading = 'flat';
     this.showSurface();
-    // The smooth program compiled while the mesh comes, in a task of its own: its first use
-    // waits for it.
-    setTimeout(() => {
-      const drawn = this.surface.material;
-      this.surface.material = this.smooth;
-      this.renderer.compile(this.scene, this.camera);
-      this.surface.material = drawn;
-    });
     const box = new THREE.Box3(new THREE.Vector3(...low), new THREE.Vector3(...high));
     this.arrivingSphere = box.getBoundingSphere(new THREE.Sphere());
     this.frameMesh(this.arrivingSphere);
@@ -818,7 +816,7 @@ export class Viewer {
       ctx.fill();
       if (e.label) {
         ctx.fillStyle = '#fff';
-        ctx.font = 'bold 10px system-ui';
+        ctx.font = 'bold 10px sans-serif'; // system-ui: the first draw looked it up for 60-170 ms
         ctx.textAlign = 'center';
         ctx.textBaseline = 'middle';
         ctx.fillText(e.label, e.x, e.y + 0.5);
