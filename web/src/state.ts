@@ -571,7 +571,8 @@ export class EditorState {
         if (reply.kind === 'fetched') {
           named(reply.id);
           if (reply.error) throw new Error(reply.error);
-          if (m && reply.id === null) throw new Error('the server has it no more'); // without a notice, none may be open yet
+          // Without a notice, none may be open yet; with one, another was opened since.
+          if (m && reply.id === null) throw new Error('the server no longer has it');
           break;
         }
         await this.meshPart(reply.part);

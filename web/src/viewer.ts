@@ -41,11 +41,11 @@ export class Viewer {
   readonly scene = new THREE.Scene();
   private readonly geometry = new THREE.BufferGeometry(); // every triangle: picking, positions
   // What is drawn: the same vertex arrays and the shown triangles, in buffers filled a part at a
-  // time (gpu.ts), at most kUploadBytes a task while a mesh arrives; the wireframe's own.
+  // time (gpu.ts), for at most kUploadMs a task while a mesh arrives; the wireframe's own.
   private readonly drawn = new THREE.BufferGeometry();
   private readonly gpu: Record<'position' | 'normal' | 'color' | 'index', GpuArray>;
   private readonly wireGeometry = new THREE.BufferGeometry();
-  // A new mesh's parts are coming, then its normals: uploads keep to kUploadBytes a task.
+  // A new mesh's parts are coming, then its normals: uploads keep to tasks of their own.
   private arriving = false;
   private arrivingSphere: THREE.Sphere | null = null; // its bounding sphere
   private hiddenMask: Uint8Array | null = null; // per vertex: hidden (H), with its triangles
@@ -258,8 +258,9 @@ export class Viewer {
     this.wireGeometry.setAttribute('position', this.gpu.position.drawn);
   }
 
-  // Changed GPU arrays go up before the next draw, or, while a mesh arrives, kUploadBytes a
-  // task of its own (not a frame: a draw of the mesh coming would hold it); the view is drawn as they go.
+  // Changed GPU arrays go up before the next draw, or, while a mesh arrives or a large frame goes
+  // up, in tasks of their own (not a frame: a draw of the mesh coming would hold it); the view is
+  // drawn as they go.
   private uploadLater(): void {
     const { position, normal, color, index } = this.gpu;
     const frame = position.framePending || normal.framePending;
