@@ -178,7 +178,7 @@ export class Viewer {
     this.gpu.normal.fresh(new Float32Array(3 * n)); // not drawn until setPositions
     this.gpu.color.set(filled(n, this.freeColor));
     this.gpu.index.fresh(indices);
-    [this.trianglesUp, this.trianglesShown] = [0, 0];
+    [this.trianglesUp, this.shownTriangles] = [0, 0];
     this.drawn.setDrawRange(0, 0);
     this.bindDrawn();
     [this.hiddenMask, this.hiddenCount] = [null, 0];
@@ -274,7 +274,7 @@ export class Viewer {
       // takes tens of milliseconds a megabyte, an idle one a few).
       const start = performance.now();
       do this.upload(this.arriving ? kUploadBytes : Infinity, kUploadBytes);
-      while (performance.now() - start < kUploadMs && Object.values(this.gpu).some((a) => a.pendingBytes > 0 || (a.framePending && !a.frameReady)));
+      while (performance.now() - start < kUploadMs && this.uploadsLeft);
       // A frame is drawn once both of its arrays are there.
       const ready = (a: GpuArray) => !a.framePending || a.frameReady;
       const swap = (position.framePending || normal.framePending) && ready(position) && ready(normal);
@@ -284,7 +284,7 @@ export class Viewer {
         this.showFrame?.();
         this.showFrame = null;
       }
-      const left = Object.values(this.gpu).some((a) => a.pendingBytes > 0 || a.framePending);
+      const left = this.uploadsLeft;
       this.uploaded = this.geometry.index !== null && // setMesh came: arrived whole (flat)
         position.pendingBytes + color.pendingBytes + index.pendingBytes === 0;
       if (this.uploaded && this.shading === 'smooth' && !normal.framePending) { // and its normals
@@ -303,6 +303,12 @@ export class Viewer {
     });
   }
   private uploadQueued = false;
+
+  // Whether changed ranges, or a frame not all up yet, wait (a frame all up waits only for its
+  // partner's, which is not).
+  private get uploadsLeft(): boolean {
+    return Object.values(this.gpu).some((a) => a.pendingBytes > 0 || (a.framePending && !a.frameReady));
+  }
 
   // Whether the GPU (a software renderer's threads) is still on the last draw: a GL call made
   // meanwhile may wait for it (most of a second for a large mesh without a GPU).
@@ -753,7 +759,7 @@ export class Viewer {
       }
       this.lastDraw = performance.now();
       const drawnRange = Math.min(this.drawn.drawRange.count, this.drawn.index?.count ?? 0) / 3;
-      this.trianglesShown = this.arriving && !this.uploaded ? Math.min(this.trianglesUp, drawnRange) : drawnRange;
+      this.shownTriangles = this.arriving && !this.uploaded ? Math.min(this.trianglesUp, drawnRange) : drawnRange;
       ++this.draws;
       // The full mesh's draws, timed one at a time, pace the next (a draw without it is quick).
       const full = this.surface.visible || this.look.mesh.visible;
@@ -784,7 +790,12 @@ export class Viewer {
   private drawAgain = false;
   private lastDraw = -Infinity;
   private trianglesUp = 0; // of an arriving mesh, uploaded so far
-  trianglesShown = 0; // by the last draw: of an arriving mesh, those uploaded, in order
+  private shownTriangles = 0;
+
+  // Triangles the last draw showed: of an arriving mesh, those uploaded (in order).
+  get trianglesShown(): number {
+    return this.shownTriangles;
+  }
 
   // The axis widget: the world axes as the camera sees them, +X red, +Y green, +Z blue.
   private axisEnds(): { axis: THREE.Vector3; x: number; y: number; depth: number; label: string; color: string }[] {
