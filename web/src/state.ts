@@ -295,6 +295,7 @@ export class EditorState {
       [this.phase.kind === 'busy', 'busy'], [this.selectionHeld, 'a held selection'],
       [this.selectionsInFlight > 0, `${this.selectionsInFlight} selections in flight`],
       [this.measuresAwaited !== null, `frame ${this.measuresAwaited}'s measures`],
+      [this.viewer.meshComing, 'the mesh going up'], // its upload waits for the GPU's last draw
     ];
     return waits.filter(([on]) => on).map(([, what]) => what);
   }

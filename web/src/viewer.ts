@@ -342,6 +342,11 @@ export class Viewer {
     return this.shading === 'smooth' && !this.arriving;
   }
 
+  // Whether a new mesh is still going up (its parts, then its normals).
+  get meshComing(): boolean {
+    return this.arriving;
+  }
+
   // Whether the mesh is drawn whole: all of it arrived and uploaded.
   get whole(): boolean {
     return (this.uploaded || !this.arriving) && this.geometry.index !== null;
